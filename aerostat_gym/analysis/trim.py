@@ -1,0 +1,210 @@
+"""Trim: the steady equilibrium of the tethered aerostat in a steady mean wind.
+
+``find_equilibrium(params, wind_speed)`` solves F(X) = 0 with the compiled right-hand side
+(all velocities zero, winch braked): the generalized forces on every tether node and on the
+aerostat (force in body axes, moment about the CM) vanish. Newton's method with a central
+finite-difference Jacobian and a minimum-norm least-squares step (at zero wind the yaw angle
+is undetermined; the min-norm step leaves it where it is) and a backtracking line search.
+The start is the exact zero-wind solution (a vertical tether with each element stretched by
+its own tension), continued in wind speed in steps of at most ``max_step`` m/s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..params import Params, load_params
+from ..physics.wind import pack_wind
+from ..simulation import Model
+
+REL_TOL = 1e-9
+
+
+class TrimError(RuntimeError):
+    """No equilibrium was found (the message says where and how close it came)."""
+
+
+@dataclass
+class Equilibrium:
+    """A trimmed state and its summary (SI units; angles in degrees in ``summary``)."""
+
+    x: np.ndarray
+    wind_speed: float
+    params: Params
+    residual: float
+    iterations: int
+    summary: dict
+
+
+def _unknown_index(model: Model) -> np.ndarray:
+    lay = model.layout
+    nodes = np.arange(3 * lay.n_nodes)
+    return np.concatenate([nodes, np.arange(lay.cm_pos.start, lay.cm_pos.stop),
+                           np.arange(lay.euler.start, lay.euler.stop)])
+
+
+def _residual(model: Model, x: np.ndarray) -> np.ndarray:
+    """Generalized forces [N, N m / aerostat length] at a zero-velocity state x."""
+    lay = model.layout
+    dx = model.rhs(x)
+    d = model.params.derived
+    L = x[lay.winch_length]
+    m_node = d.mass_per_length * L / model.n
+    node_f = m_node * dx[lay.node_vel]
+    from ..physics.core import rotation_matrix
+
+    R = rotation_matrix(*x[lay.euler])
+    body_f = np.array(d.effective_mass) * (R.T @ dx[lay.cm_vel])
+    a = model.params.aerostat
+    inertia = np.array([[a.Ixx, 0, -a.Ixz], [0, a.Iyy, 0], [-a.Ixz, 0, a.Izz]])
+    moment = inertia @ dx[lay.rates] / a.length
+    return np.concatenate([node_f, body_f, moment])
+
+
+def zero_wind_state(params: Params, length: float | None = None) -> np.ndarray:
+    """Exact equilibrium at zero wind: a vertical tether with elements stretched by their own
+    tension, the aerostat at the configured trim pitch, facing into the configured wind."""
+    model = Model(params, 0.0)
+    lay, d, n = model.layout, params.derived, model.n
+    L = params.tether.length if length is None else length
+    l_u = L / n
+    g = params.environment.g
+    m_node = d.mass_per_length * l_u
+    # element e carries the net lift minus the weight of the nodes above its midpoint
+    T = d.net_lift - m_node * g * (np.arange(n) + 0.5)
+    lengths = l_u * (1.0 + T / d.EA)
+    anchor = np.array(params.tether.anchor_position)
+    z_nodes = anchor[2] + np.cumsum(lengths[::-1])[::-1]  # height of node e (top = node 0)
+    x = np.zeros(lay.size)
+    for j in range(1, n):
+        x[3 * (j - 1):3 * j] = [anchor[0], anchor[1], z_nodes[j]]
+    th = math.radians(params.aerostat.trim_pitch_deg)
+    psi = math.radians(params.wind.direction_deg) + math.pi
+    x[lay.euler] = [0.0, th, psi]
+    from ..physics.core import rotation_matrix
+
+    R = rotation_matrix(0.0, th, psi)
+    confluence = np.array([anchor[0], anchor[1], z_nodes[0]])
+    x[lay.cm_pos] = confluence - R @ np.array(d.leash_position)
+    x[lay.winch_length] = L
+    return x
+
+
+def _newton(model: Model, x: np.ndarray, tol: float, max_iter: int) -> tuple[np.ndarray, float, int]:
+    idx = _unknown_index(model)
+    scale = model.params.derived.buoyancy
+    steps = np.where(np.isin(idx, np.arange(model.layout.euler.start, model.layout.euler.stop)),
+                     1e-7, 1e-5)
+    r = _residual(model, x)
+    rel = np.max(np.abs(r)) / scale
+    for it in range(max_iter):
+        if rel <= tol:
+            return x, rel, it
+        J = np.empty((r.size, idx.size))
+        for k, (i, h) in enumerate(zip(idx, steps, strict=True)):
+            xp, xm = x.copy(), x.copy()
+            xp[i] += h
+            xm[i] -= h
+            J[:, k] = (_residual(model, xp) - _residual(model, xm)) / (2 * h)
+        dz = np.linalg.lstsq(J, -r, rcond=1e-13)[0]
+        lam = 1.0
+        for _ in range(30):
+            xn = x.copy()
+            xn[idx] += lam * dz
+            rn = _residual(model, xn)
+            reln = np.max(np.abs(rn)) / scale
+            if np.all(np.isfinite(rn)) and reln < rel:
+                break
+            lam *= 0.5
+        else:
+            return x, rel, it
+        x, r, rel = xn, rn, reln
+    return x, rel, max_iter
+
+
+def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
+                     guess: Equilibrium | None = None, max_step: float = 1.0,
+                     tol: float = REL_TOL, length: float | None = None) -> Equilibrium:
+    """Trim in a steady mean wind of ``wind_speed`` m/s (profile and direction from params).
+
+    Parameters
+    ----------
+    params : Params (default baseline). wind_speed : mean speed at the reference height [m/s].
+    guess : a nearby equilibrium (same params) to continue from; default the zero-wind state.
+    max_step : largest continuation step in wind speed [m/s].
+    tol : relative residual, max |generalized force| / buoyancy.
+    length : tether length paid out [m] (default ``tether.length``).
+
+    Raises
+    ------
+    TrimError if Newton fails to reach ``tol`` even with continuation steps of 1/64 of
+    ``max_step``, or if the solution has a slack tether or the aerostat below the anchor.
+    """
+    params = params or load_params()
+    if not (math.isfinite(wind_speed) and wind_speed >= 0):
+        raise ValueError(f"wind_speed must be finite and >= 0, got {wind_speed!r}")
+    model = Model(params, 0.0)
+    if guess is None:
+        x, u0 = zero_wind_state(params, length), 0.0
+    else:
+        x, u0 = guess.x.copy(), guess.wind_speed
+    rel, its = 0.0, 0
+    step = max_step
+    u = u0
+    while True:
+        target = min(u + step, wind_speed) if wind_speed >= u else max(u - step, wind_speed)
+        _set_speed(model, params, target)
+        xn, rel, it = _newton(model, x.copy(), tol, 40)
+        its += it
+        if rel <= tol:
+            x, u = xn, target
+            if u == wind_speed:
+                break
+            step = min(max_step, 2 * step)
+        else:
+            step /= 2
+            if step < max_step / 64:
+                raise TrimError(f"no equilibrium found at U = {target:.3f} m/s (continuing from "
+                                f"{u:.3f} m/s): relative residual {rel:.2e} > {tol:.0e}")
+    _set_speed(model, params, wind_speed)
+    summary = trim_summary(model, x, wind_speed)
+    if summary["min_tension_N"] <= 0 or x[model.layout.cm_pos][2] <= 0:
+        raise TrimError(f"the solution at U = {wind_speed} m/s is not a flying equilibrium "
+                        f"(min tension {summary['min_tension_N']:.1f} N, height {x[model.layout.cm_pos][2]:.1f} m)")
+    return Equilibrium(x=x, wind_speed=float(wind_speed), params=params, residual=float(rel),
+                       iterations=its, summary=summary)
+
+
+def _set_speed(model: Model, params: Params, speed: float) -> None:
+    w = params.wind
+    model.wp = pack_wind(w.profile, speed, w.direction_deg, w.reference_height,
+                         w.shear_exponent, w.roughness_length)
+
+
+def trim_summary(model: Model, x: np.ndarray, wind_speed: float) -> dict:
+    """Aerostat position, blow-by angle, attitude, end tensions and tether elevation at the winch."""
+    lay = model.layout
+    nodes = model.node_positions(x)
+    top, bottom = model.end_tensions(x)
+    rel = nodes[0] - nodes[-1]
+    blow_by = math.degrees(math.atan2(math.hypot(rel[0], rel[1]), rel[2]))
+    low = nodes[-2] - nodes[-1]
+    elevation = math.degrees(math.atan2(low[2], math.hypot(low[0], low[1])))
+    phi, th, psi = x[lay.euler]
+    return {
+        "wind_speed_m_s": float(wind_speed),
+        "aerostat_position_m": [float(v) for v in x[lay.cm_pos]],
+        "confluence_point_m": [float(v) for v in nodes[0]],
+        "blow_by_deg": blow_by,
+        "pitch_deg": math.degrees(th),
+        "roll_deg": math.degrees(phi),
+        "yaw_deg": math.degrees(psi),
+        "top_tension_N": top,
+        "bottom_tension_N": bottom,
+        "min_tension_N": float(model.tensions(x).min()),
+        "elevation_at_winch_deg": elevation,
+        "tether_length_m": float(x[lay.winch_length]),
+    }

@@ -1,0 +1,454 @@
+"""Model parameters: frozen dataclasses per component, mirrored one to one by TOML.
+
+The baseline case (Aeros Flightcam aerostat on a 300 m Plasma tether, [LN02]) ships as
+``aerostat_gym/data/aeros_flightcam.toml``. Every field carries its unit and the status of the
+baseline value (SOURCED, DERIVED, ESTIMATE, CALIB) in its dataclass metadata, so
+``parameter_table()`` can tell a user which numbers are measured and which are guesses.
+
+Loading is strict: an unknown key, a missing key or section, a wrong type or an impossible
+value raises :class:`ParameterError` naming the field and the value. Quantities that follow
+from the inputs (buoyancy, net lift, leash x_l, EA, element mass, tether damping, added masses)
+are computed in :class:`Derived`, never typed in.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field, fields
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+try:  # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover
+    import tomli as tomllib  # type: ignore[no-redef]
+
+
+class ParameterError(ValueError):
+    """An invalid, unknown or missing parameter. The message names the field and the value."""
+
+
+# --- field helpers -----------------------------------------------------------------------------
+
+POSITIVE, NONNEG, ANY, INT_GE1, STALL, VEC3, COEFFS = (
+    "positive", "nonneg", "any", "int>=1", "stall", "vec3", "coeffs",
+)
+
+
+def _f(unit: str, status: str, check: str = ANY, doc: str = "", default: Any = dataclasses.MISSING):
+    meta = {"unit": unit, "status": status, "check": check, "doc": doc}
+    if default is dataclasses.MISSING:
+        return field(metadata=meta)
+    if isinstance(default, (list, tuple)):
+        return field(default_factory=lambda d=tuple(default): d, metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+# --- components ----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class EnvironmentParams:
+    rho_air: float = _f("kg/m^3", "DERIVED", POSITIVE, "air density (Table 2 fit, Option A)")
+    g: float = _f("m/s^2", "ESTIMATE", POSITIVE, "gravitational acceleration")
+
+
+@dataclass(frozen=True)
+class AerostatParams:
+    length: float = _f("m", "SOURCED", POSITIVE, "hull length")
+    diameter: float = _f("m", "SOURCED", POSITIVE, "maximum hull diameter")
+    volume: float = _f("m^3", "SOURCED", POSITIVE, "total (buoyant) volume")
+    mass: float = _f("kg", "DERIVED", POSITIVE, "total mass incl. helium and ballonet air")
+    Ixx: float = _f("kg m^2", "ESTIMATE", POSITIVE, "roll inertia about the CM")
+    Iyy: float = _f("kg m^2", "ESTIMATE", POSITIVE, "pitch inertia about the CM")
+    Izz: float = _f("kg m^2", "ESTIMATE", POSITIVE, "yaw inertia about the CM")
+    Ixz: float = _f("kg m^2", "ESTIMATE", ANY, "product of inertia, integral of x z dm")
+    cb_position: tuple = _f("m", "CALIB", VEC3, "centre of buoyancy relative to the CM (body)")
+    nose_position: tuple = _f("m", "CALIB", VEC3, "nose relative to the CM (body); z = hull axis")
+    leash_z: float = _f("m", "SOURCED", ANY, "confluence point height relative to the CM (1.5 D below axis)")
+    trim_pitch_deg: float = _f("deg", "SOURCED", ANY, "zero-wind trim pitch (negative = nose up)")
+    k1: float = _f("-", "ESTIMATE", NONNEG, "axial added-mass coefficient")
+    k3: float = _f("-", "ESTIMATE", NONNEG, "lateral added-mass coefficient (y and z)")
+
+
+@dataclass(frozen=True)
+class HullParams:
+    l_h: float = _f("m", "ESTIMATE", POSITIVE, "nose to fin-root leading edge (hull region)")
+    I1: float = _f("m^2", "ESTIMATE", ANY, "Jones-DeLaurier integral I1 = A_h")
+    I3: float = _f("m^3", "ESTIMATE", ANY, "Jones-DeLaurier integral I3 = l_h A_h - V_h")
+    J1: float = _f("m^2", "ESTIMATE", NONNEG, "side-projected area of the hull region")
+    J2: float = _f("m^3", "ESTIMATE", ANY, "first moment of J1 about the nose")
+    CD0: float = _f("-", "ESTIMATE", NONNEG, "zero-alpha axial drag coefficient on V^(2/3)")
+    Cdc: float = _f("-", "ESTIMATE", NONNEG, "cross-flow drag coefficient on J1")
+    eta_k: float = _f("-", "CALIB", NONNEG, "hull efficiency factor")
+
+
+@dataclass(frozen=True)
+class FinPanel:
+    name: str = _f("-", "SOURCED", ANY, "panel name")
+    roll_angle_deg: float = _f("deg", "SOURCED", ANY, "span direction (0, sin, cos) of this angle")
+    cp_position: tuple = _f("m", "CALIB", VEC3, "quarter-chord mid-span point relative to the CM")
+
+
+@dataclass(frozen=True)
+class FinParams:
+    planform_area: float = _f("m^2", "ESTIMATE", NONNEG, "planform area per fin")
+    aspect_ratio: float = _f("-", "ESTIMATE", POSITIVE, "aspect ratio used for induced drag")
+    CL_alpha: float = _f("1/rad", "ESTIMATE", NONNEG, "3-D lift slope incl. interference loss")
+    alpha_stall_deg: float = _f("deg", "ESTIMATE", STALL, "stall angle; C_L flat beyond it")
+    CD0: float = _f("-", "ESTIMATE", NONNEG, "parasite drag coefficient")
+    oswald_e: float = _f("-", "ESTIMATE", POSITIVE, "Oswald efficiency")
+    panels: tuple = _f("-", "SOURCED", ANY, "fin panels (inverted Y: upper, port, starboard)")
+
+
+@dataclass(frozen=True)
+class TetherParams:
+    length: float = _f("m", "SOURCED", POSITIVE, "unstretched tether length paid out")
+    n_elements: int = _f("-", "SOURCED", INT_GE1, "number of lumped-mass elements")
+    diameter: float = _f("m", "SOURCED", POSITIVE, "tether diameter")
+    density: float = _f("kg/m^3", "SOURCED", POSITIVE, "tether material density")
+    youngs_modulus: float = _f("Pa", "SOURCED", POSITIVE, "effective Young's modulus")
+    damping_ratio: float = _f("-", "SOURCED", NONNEG, "damping ratio zeta, b = zeta b_c")
+    strength: float = _f("N", "SOURCED", POSITIVE, "breaking strength")
+    Cd_normal: float = _f("-", "ESTIMATE", NONNEG, "normal drag coefficient")
+    loading_fn: tuple = _f("-", "ESTIMATE", COEFFS, "f_n coefficients of [1, cos, sin, cos2, sin2]")
+    loading_ft: tuple = _f("-", "ESTIMATE", COEFFS, "f_t polynomial coefficients in phi, ascending")
+    anchor_position: tuple = _f("m", "ESTIMATE", VEC3, "winch / anchor position (inertial)")
+
+
+@dataclass(frozen=True)
+class WinchParams:
+    equivalent_mass: float = _f("kg", "ESTIMATE", POSITIVE, "drivetrain inertia reflected to the line")
+    coulomb_friction: float = _f("N", "ESTIMATE", NONNEG, "Coulomb friction at the line")
+    viscous_friction: float = _f("N s/m", "ESTIMATE", NONNEG, "viscous friction at the line")
+    max_motor_force: float = _f("N", "ESTIMATE", POSITIVE, "motor force limit at the line")
+    max_speed: float = _f("m/s", "ESTIMATE", POSITIVE, "reel speed limit")
+    max_acceleration: float = _f("m/s^2", "ESTIMATE", POSITIVE, "reel acceleration limit")
+    speed_time_constant: float = _f("s", "ESTIMATE", POSITIVE, "closed speed-loop time constant")
+    brake_speed: float = _f("m/s", "ESTIMATE", NONNEG, "set-points below this engage the brake")
+    min_length: float = _f("m", "ESTIMATE", POSITIVE, "shortest tether length")
+    max_length: float = _f("m", "ESTIMATE", POSITIVE, "longest tether length")
+    safe_working_load: float = _f("N", "ESTIMATE", POSITIVE, "over-tension threshold")
+    slack_tension: float = _f("N", "ESTIMATE", NONNEG, "slack threshold")
+
+
+@dataclass(frozen=True)
+class WindParams:
+    profile: str = _f("-", "SOURCED", ANY, "mean profile: uniform, power or log")
+    speed: float = _f("m/s", "SOURCED", NONNEG, "mean speed at the reference height")
+    direction_deg: float = _f("deg", "ESTIMATE", ANY, "heading the wind blows toward, from +X to +Y")
+    reference_height: float = _f("m", "ESTIMATE", POSITIVE, "reference height of power/log profiles")
+    shear_exponent: float = _f("-", "ESTIMATE", NONNEG, "power-law exponent")
+    roughness_length: float = _f("m", "ESTIMATE", POSITIVE, "log-law roughness length")
+
+
+@dataclass(frozen=True)
+class SimulationParams:
+    rk4_safety: float = _f("-", "ESTIMATE", POSITIVE, "fraction of the RK4 stability bound used")
+    semi_implicit_dt: float = _f("s", "ESTIMATE", POSITIVE, "semi-implicit integrator step")
+
+
+@dataclass(frozen=True)
+class Params:
+    """All parameters of one tethered-aerostat system. Immutable; use :meth:`replace`."""
+
+    environment: EnvironmentParams
+    aerostat: AerostatParams
+    hull: HullParams
+    fins: FinParams
+    tether: TetherParams
+    winch: WinchParams
+    wind: WindParams
+    simulation: SimulationParams
+
+    def replace(self, **dotted: Any) -> Params:
+        """Return a copy with single values replaced, e.g. ``replace(**{"tether.length": 150})``."""
+        return apply_overrides(self, dotted)
+
+    @property
+    def derived(self) -> Derived:
+        return Derived.from_params(self)
+
+
+SECTIONS = {
+    "environment": EnvironmentParams,
+    "aerostat": AerostatParams,
+    "hull": HullParams,
+    "fins": FinParams,
+    "tether": TetherParams,
+    "winch": WinchParams,
+    "wind": WindParams,
+    "simulation": SimulationParams,
+}
+
+WIND_PROFILES = ("uniform", "power", "log")
+
+# --- validation ----------------------------------------------------------------------------------
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
+    """Coerce and check one value against its field's declared type and constraint."""
+    check = f.metadata["check"]
+    if check == VEC3:
+        if not (isinstance(value, (list, tuple)) and len(value) == 3 and all(map(_is_number, value))):
+            raise ParameterError(f"{name} must be a list of 3 numbers, got {value!r}")
+        value = tuple(float(v) for v in value)
+        if not all(math.isfinite(v) for v in value):
+            raise ParameterError(f"{name} must be finite, got {value!r}")
+        return value
+    if check == COEFFS:
+        if not (isinstance(value, (list, tuple)) and value and all(map(_is_number, value))):
+            raise ParameterError(f"{name} must be a non-empty list of numbers, got {value!r}")
+        return tuple(float(v) for v in value)
+    if f.type in ("str", str):
+        if not isinstance(value, str):
+            raise ParameterError(f"{name} must be a string, got {value!r}")
+        return value
+    if check == INT_GE1:
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ParameterError(f"{name} must be an integer >= 1, got {value!r}")
+        return int(value)
+    if not _is_number(value):
+        raise ParameterError(f"{name} must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ParameterError(f"{name} must be finite, got {value!r}")
+    if check == POSITIVE and value <= 0:
+        raise ParameterError(f"{name} must be > 0, got {value!r}")
+    if check == NONNEG and value < 0:
+        raise ParameterError(f"{name} must be >= 0, got {value!r}")
+    if check == STALL and not 0 < value < 90:
+        raise ParameterError(f"{name} must lie in (0, 90) deg, got {value!r}")
+    return value
+
+
+def _build(cls: type, name: str, table: Any) -> Any:
+    if not isinstance(table, dict):
+        raise ParameterError(f"[{name}] must be a table, got {table!r}")
+    known = {f.name: f for f in fields(cls)}
+    unknown = sorted(set(table) - set(known))
+    if unknown:
+        raise ParameterError(f"unknown key(s) in [{name}]: {', '.join(unknown)}")
+    missing = sorted(set(known) - set(table))
+    if missing:
+        raise ParameterError(f"missing key(s) in [{name}]: {', '.join(missing)}")
+    values = {}
+    for key, f in known.items():
+        if cls is FinParams and key == "panels":
+            values[key] = _build_panels(table[key])
+        else:
+            values[key] = _check_value(f"{name}.{key}", table[key], f)
+    return cls(**values)
+
+
+def _build_panels(panels: Any) -> tuple:
+    if not isinstance(panels, list) or not panels:
+        raise ParameterError(f"fins.panels must be a non-empty array of tables, got {panels!r}")
+    return tuple(_build(FinPanel, f"fins.panels[{i}]", p) for i, p in enumerate(panels))
+
+
+def _cross_checks(p: Params) -> None:
+    """Constraints between fields, checked after every load or override."""
+    if p.wind.profile not in WIND_PROFILES:
+        raise ParameterError(f"wind.profile must be one of {WIND_PROFILES}, got {p.wind.profile!r}")
+    if p.winch.min_length >= p.winch.max_length:
+        raise ParameterError(
+            f"winch.min_length ({p.winch.min_length}) must be < winch.max_length ({p.winch.max_length})"
+        )
+    if not -89.0 < p.aerostat.trim_pitch_deg < 89.0:
+        raise ParameterError(f"aerostat.trim_pitch_deg must lie in (-89, 89), got {p.aerostat.trim_pitch_deg}")
+    d = Derived.from_params(p)
+    if d.net_lift <= 0:
+        raise ParameterError(
+            f"aerostat.mass = {p.aerostat.mass} kg gives no net lift (buoyancy {d.buoyancy:.1f} N "
+            f"<= weight {p.aerostat.mass * p.environment.g:.1f} N)"
+        )
+
+
+def params_from_dict(data: dict) -> Params:
+    """Build :class:`Params` from a nested dict (the parsed TOML), strictly."""
+    if not isinstance(data, dict):
+        raise ParameterError("parameter data must be a table")
+    unknown = sorted(set(data) - set(SECTIONS))
+    if unknown:
+        raise ParameterError(f"unknown section(s): {', '.join(unknown)}")
+    missing = [s for s in SECTIONS if s not in data]
+    if missing:
+        raise ParameterError(f"missing section(s): {', '.join(missing)}")
+    p = Params(**{name: _build(cls, name, data[name]) for name, cls in SECTIONS.items()})
+    _cross_checks(p)
+    return p
+
+
+def params_to_dict(p: Params) -> dict:
+    """Nested plain dict of all inputs (round-trips through :func:`params_from_dict`)."""
+    out = {}
+    for name in SECTIONS:
+        sec = dataclasses.asdict(getattr(p, name))
+        out[name] = {k: (list(v) if isinstance(v, tuple) and k != "panels" else v) for k, v in sec.items()}
+    out["fins"]["panels"] = [
+        {**pan, "cp_position": list(pan["cp_position"])} for pan in out["fins"]["panels"]
+    ]
+    return out
+
+
+def apply_overrides(p: Params, overrides: dict[str, Any]) -> Params:
+    """Replace single values by dotted name (``"tether.length"``), with the same checks as loading."""
+    data = params_to_dict(p)
+    for key, value in overrides.items():
+        parts = key.split(".")
+        if len(parts) != 2 or parts[0] not in SECTIONS:
+            raise ParameterError(f"unknown parameter {key!r} (use 'section.key', sections: {', '.join(SECTIONS)})")
+        sec, name = parts
+        if name not in data[sec]:
+            raise ParameterError(f"unknown parameter {key!r}")
+        data[sec][name] = list(value) if isinstance(value, tuple) else value
+    return params_from_dict(data)
+
+
+def load_params(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Params:
+    """Load parameters from a TOML file (default: the shipped baseline) and apply overrides."""
+    if path is None:
+        text = resources.files("aerostat_gym").joinpath("data/aeros_flightcam.toml").read_text()
+        source = "baseline"
+    else:
+        path = Path(path)
+        if not path.is_file():
+            raise ParameterError(f"parameter file not found: {path}")
+        text = path.read_text()
+        source = str(path)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{source}: invalid TOML: {exc}") from exc
+    p = params_from_dict(data)
+    return apply_overrides(p, overrides) if overrides else p
+
+
+def default_params(**overrides: Any) -> Params:
+    """The baseline case; keyword overrides use ``__`` for the dot: ``tether__length=150``."""
+    return load_params(overrides={k.replace("__", "."): v for k, v in overrides.items()} or None)
+
+
+def dumps_toml(p: Params) -> str:
+    """Serialise the inputs to TOML (used to store the resolved parameters of every run)."""
+
+    def fmt(v: Any) -> str:
+        if isinstance(v, str):
+            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, (list, tuple)):
+            return "[" + ", ".join(fmt(x) for x in v) + "]"
+        return repr(v)
+
+    data = params_to_dict(p)
+    lines = []
+    for sec, table in data.items():
+        lines.append(f"[{sec}]")
+        for k, v in table.items():
+            if k != "panels":
+                lines.append(f"{k} = {fmt(v)}")
+        lines.append("")
+        if sec == "fins":
+            for pan in table["panels"]:
+                lines.append("[[fins.panels]]")
+                lines.extend(f"{k} = {fmt(v)}" for k, v in pan.items())
+                lines.append("")
+    return "\n".join(lines)
+
+
+def parameter_table(p: Params | None = None) -> list[dict]:
+    """Rows (name, value, unit, status, description) of every input, for reports and the CLI."""
+    p = p or load_params()
+    rows = []
+    for sec in SECTIONS:
+        obj = getattr(p, sec)
+        for f in fields(obj):
+            if f.name == "panels":
+                for i, pan in enumerate(obj.panels):
+                    for g in fields(pan):
+                        rows.append(_row(f"fins.panels[{i}].{g.name}", getattr(pan, g.name), g))
+            else:
+                rows.append(_row(f"{sec}.{f.name}", getattr(obj, f.name), f))
+    return rows
+
+
+def _row(name: str, value: Any, f: dataclasses.Field) -> dict:
+    m = f.metadata
+    return {"name": name, "value": value, "unit": m["unit"], "status": m["status"], "description": m["doc"]}
+
+
+# --- derived quantities --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Derived:
+    """Quantities computed from the inputs ([LN02] and docs/parameters.md, section 4).
+
+    Notes
+    -----
+    - buoyancy B = rho g V; net lift B - m g.
+    - leash x_l from the zero-wind moment balance about the CM at trim pitch theta_0:
+      B (x_b cos th + z_b sin th) = (B - m g)(x_l cos th + z_l sin th).
+    - EA = E pi d^2 / 4; mu = rho_t A; element mass mu l_u, l_u = L / n.
+    - b_c = 2 sqrt(EA m_el l_u) = 2 l_u A sqrt(E rho_t); b = zeta b_c. Because b is proportional
+      to l_u, the element dashpot c* = b / l_u (force per unit of relative axial speed) does not
+      depend on the element length; it is what the compiled core uses.
+    - added masses m_a = k rho V per axis; effective masses m_e = m + m_a.
+    """
+
+    buoyancy: float
+    net_lift: float
+    leash_position: tuple
+    EA: float
+    tether_area: float
+    mass_per_length: float
+    element_length: float
+    element_mass: float
+    critical_damping: float
+    damping_b: float
+    dashpot: float
+    added_mass: tuple
+    effective_mass: tuple
+    tether_weight: float
+    reference_area: float
+
+    @classmethod
+    def from_params(cls, p: Params) -> Derived:
+        env, a, t = p.environment, p.aerostat, p.tether
+        B = env.rho_air * env.g * a.volume
+        F_lz = B - a.mass * env.g
+        th = math.radians(a.trim_pitch_deg)
+        xb, _, zb = a.cb_position
+        zl = a.leash_z
+        x_l = (B * (xb + zb * math.tan(th)) - F_lz * zl * math.tan(th)) / F_lz if F_lz > 0 else float("nan")
+        area = math.pi * t.diameter**2 / 4.0
+        mu = t.density * area
+        l_u = t.length / t.n_elements
+        EA = t.youngs_modulus * area
+        b_c = 2.0 * l_u * area * math.sqrt(t.youngs_modulus * t.density)
+        ma = (a.k1 * env.rho_air * a.volume, a.k3 * env.rho_air * a.volume, a.k3 * env.rho_air * a.volume)
+        return cls(
+            buoyancy=B,
+            net_lift=F_lz,
+            leash_position=(x_l, 0.0, zl),
+            EA=EA,
+            tether_area=area,
+            mass_per_length=mu,
+            element_length=l_u,
+            element_mass=mu * l_u,
+            critical_damping=b_c,
+            damping_b=t.damping_ratio * b_c,
+            dashpot=t.damping_ratio * b_c / l_u,
+            added_mass=ma,
+            effective_mass=tuple(a.mass + m for m in ma),
+            tether_weight=mu * t.length * env.g,
+            reference_area=a.volume ** (2.0 / 3.0),
+        )

@@ -1,0 +1,528 @@
+"""The right-hand side of the tethered-aerostat model, compiled with numba.
+
+One function, :func:`rhs`, is the single source of truth: the integrators, the trim solver, the
+linearization (and therefore the LQR baseline) and the environment all call it.
+
+Frames and signs (written once, here)
+-------------------------------------
+- Inertial frame: origin at the winch/anchor, Z up; the default mean wind blows toward +X.
+- Body frame: origin at the CM, x toward the nose, y to port, z up ([LN02]). Attitude by Z-Y-X
+  Euler angles (psi, theta, phi): R = Rz(psi) Ry(theta) Rx(phi) maps body to inertial
+  components. theta < 0 is nose up. At trim in a +X wind the nose points upwind, psi = pi.
+- Body rates (p, q, r) about body x, y, z.
+
+Model ([LN02]; equations reconstructed in docs/parameters.md section 4)
+-----------------------------------------------------------------------
+- Tether: n elements between node 1 (the confluence point, rigidly attached to the aerostat)
+  and node n + 1 (the anchor). Element mass mu l_u lumped half to each end node; the top half
+  mass weighs on the aerostat at the confluence point. Tension-only viscoelastic elements
+  T = EA eps + b deps/dt with l_u = L / n and b = c* l_u, so T = EA eps + c* (ldot - l Ldot / L).
+  Morison drag with loading functions from each element's midpoint velocity relative to the
+  air, half to each end node; gravity on every node.
+- Aerostat: buoyancy B = rho g V at the centre of buoyancy, weight at the CM, Jones & DeLaurier
+  hull forces and nose moment (applied as forces at the nose plus the moment, which equals
+  forces at the centre of pressure and has no 0/0 at alpha -> 0), three fins with local alpha
+  from the air-relative velocity at their own point (V + omega x r - wind), linear lift to
+  stall then flat, induced drag from the unsaturated C_L.
+- Inertia: translational added mass m_e = m + k rho V per body axis. The inertial terms use
+  Kirchhoff's form M_e dV/dt + omega x (M_e V) = F and I domega/dt + omega x I omega
+  + V x (M_a V) = M with V the ground-relative CM velocity. This is the rigid-body mechanics of
+  an anisotropic inertia, conserves energy exactly, and equals [LN02]'s m_e (dV/dt + omega x V)
+  to first order about any trim (where V = 0), so trim and linearization are [LN02]'s. The
+  steady-flow Munk moment stays in the hull's (k3 - k1) eta_k terms on the air-relative velocity.
+- Winch: reel-out speed set-point through a speed loop (first-order lag with acceleration and
+  speed limits) acting on a drivetrain reflected to the line (equivalent mass, Coulomb and
+  viscous friction, motor force limit); the brake holds the drum.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .layout import (
+    MAX_FINS,
+    P_AF,
+    P_ANCHOR,
+    P_ASTALL,
+    P_BUOY,
+    P_CB,
+    P_CD0F,
+    P_CD0H,
+    P_CDC,
+    P_CDN,
+    P_CLA,
+    P_DASHPOT,
+    P_DIAM,
+    P_EA,
+    P_FIN,
+    P_FIXED,
+    P_FN,
+    P_FT,
+    P_G,
+    P_I1,
+    P_I3,
+    P_IINV,
+    P_INERTIA,
+    P_J1,
+    P_J2,
+    P_KIND,
+    P_KPOT,
+    P_LEASH,
+    P_MA,
+    P_MASS,
+    P_ME,
+    P_MU,
+    P_NEL,
+    P_NFIN,
+    P_NOSE,
+    P_RHO,
+    P_SH,
+    P_W_AMAX,
+    P_W_CV,
+    P_W_FC,
+    P_W_FMAX,
+    P_W_FRICTION_V,
+    P_W_LMAX,
+    P_W_LMIN,
+    P_W_MEQ,
+    P_W_TAU,
+    P_W_VMAX,
+)
+from .wind import W_DIRC, W_DIRS, W_GUST_ON, W_PROFILE, W_TURB_ON, W_UREF, air_velocity, mean_speed
+
+# fastmath without the no-NaN/no-Inf assumptions, so non-finite states are still detected.
+FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
+
+# Work-array layout: node positions, velocities and forces, 3 (n + 1) each (node 0 = confluence
+# point, node n = anchor); the n element tensions; the wind sample points (n element midpoints,
+# the hull point, the fin points), 3 each, followed by the air velocity at each of them.
+
+
+def work_size(n: int) -> int:
+    return _pts(n) + 6 * (n + 1 + MAX_FINS)
+
+
+@njit(cache=True, inline="always")
+def _pts(n):
+    """Offset of the wind sample points in the work array (their winds follow them)."""
+    return 9 * (n + 1) + n
+
+
+# atan(r) = r P(r^2) on [0, 1], least-squares fit on Chebyshev nodes: max error 8.3e-12 rad.
+# Used instead of math.atan2 in the loading functions and fin angles (13 atan2 per RHS call).
+_ATAN_C = (0.999999999996503, -0.3333333310350973, 0.19999984562222467, -0.1428533158589695,
+           0.1110626414598247, -0.09054362224365327, 0.07513230362760116, -0.06063488520294236,
+           0.044282885594268885, -0.026656175176109326, 0.011850251192783857,
+           -0.0033536231441468126, 0.000445188573384353)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _atan01(r):
+    z = r * r
+    acc = _ATAN_C[12]
+    for k in range(11, -1, -1):
+        acc = acc * z + _ATAN_C[k]
+    return r * acc
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def fast_atan2(y, x):
+    """atan2(y, x) to 1e-11 rad via octant reduction and :data:`_ATAN_C`."""
+    ax, ay = abs(x), abs(y)
+    if ax == 0.0 and ay == 0.0:
+        return 0.0
+    if ay <= ax:
+        a = _atan01(ay / ax)
+    else:
+        a = 0.5 * math.pi - _atan01(ax / ay)
+    if x < 0.0:
+        a = math.pi - a
+    return -a if y < 0.0 else a
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _rotation(ph, th, ps):
+    cph, sph = math.cos(ph), math.sin(ph)
+    cth, sth = math.cos(th), math.sin(th)
+    cps, sps = math.cos(ps), math.sin(ps)
+    return (cth * cps, sph * sth * cps - cph * sps, cph * sth * cps + sph * sps,
+            cth * sps, sph * sth * sps + cph * cps, cph * sth * sps - sph * cps,
+            -sth, sph * cth, cph * cth, cph, sph, cth, sth)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def rotation_matrix(ph, th, ps):
+    """Body-to-inertial rotation matrix for Z-Y-X Euler angles (3x3 array)."""
+    r = _rotation(ph, th, ps)[:9]
+    out = np.empty((3, 3))
+    for i in range(9):
+        out[i // 3, i % 3] = r[i]
+    return out
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def _kinematics(x, p, R, w):
+    """Fill the work array with node positions and velocities (node 0 = confluence point from
+    the aerostat state, node n = anchor) and the points where the wind is sampled: element
+    midpoints, then the hull point (centre of buoyancy), then each fin's point."""
+    n = int(p[P_NEL])
+    nm = n - 1
+    o = 6 * nm
+    P, V, PT = 0, 3 * (n + 1), _pts(n)
+    xl, yl, zl = p[P_LEASH], p[P_LEASH + 1], p[P_LEASH + 2]
+    pp, qq, rr = x[o + 9], x[o + 10], x[o + 11]
+    wx, wy, wz = qq * zl - rr * yl, rr * xl - pp * zl, pp * yl - qq * xl
+    for k in range(3):
+        # confluence point r_cm + R r_l, velocity v_cm + R (omega x r_l)
+        w[P + k] = x[o + k] + R[3 * k] * xl + R[3 * k + 1] * yl + R[3 * k + 2] * zl
+        w[V + k] = x[o + 3 + k] + R[3 * k] * wx + R[3 * k + 1] * wy + R[3 * k + 2] * wz
+        w[P + 3 * n + k] = p[P_ANCHOR + k]
+        w[V + 3 * n + k] = 0.0
+    for i in range(3 * nm):
+        w[P + 3 + i] = x[i]
+        w[V + 3 + i] = x[3 * nm + i]
+    for i in range(3 * n):
+        w[PT + i] = 0.5 * (w[P + i] + w[P + 3 + i])
+    nf = int(p[P_NFIN])
+    for c in range(nf + 1):
+        b = P_CB if c == 0 else P_FIN + 9 * (c - 1)
+        cx, cy, cz = p[b], p[b + 1], p[b + 2]
+        for k in range(3):
+            w[PT + 3 * (n + c) + k] = x[o + k] + R[3 * k] * cx + R[3 * k + 1] * cy + R[3 * k + 2] * cz
+    return n + nf + 1
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def wind_batch(t, w, npts, base, wp, wf):
+    """Air velocity at the npts points stored from ``w[base]``, written just after them.
+
+    Branches once on the wind features: a steady mean wind (the trim and the paper's case)
+    takes a short path; gusts and turbulence go through :func:`air_velocity` point by point.
+    """
+    out = base + 3 * npts
+    if wp[W_GUST_ON] == 0.0 and (wp[W_TURB_ON] == 0.0 or wf.shape[1] < 2):
+        c, s = wp[W_DIRC], wp[W_DIRS]
+        uniform = wp[W_PROFILE] == 0.0
+        u0 = wp[W_UREF]
+        for i in range(npts):
+            um = u0 if uniform else mean_speed(w[base + 3 * i + 2], wp)
+            w[out + 3 * i] = c * um
+            w[out + 3 * i + 1] = s * um
+            w[out + 3 * i + 2] = 0.0
+        return
+    for i in range(npts):
+        ax, ay, az = air_velocity(w[base + 3 * i], w[base + 3 * i + 1], w[base + 3 * i + 2], t, wp, wf)
+        w[out + 3 * i] = ax
+        w[out + 3 * i + 1] = ay
+        w[out + 3 * i + 2] = az
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def _tether(x, p, w):
+    """Element tensions and node forces of the tether (inertial), from the kinematics and the
+    winds already in the work array. Node 0's force acts on the aerostat. Returns the
+    winch-end element tension.
+
+    The element pass is branch-free so that LLVM vectorizes it; the per-element force
+    (T e and the drag) is then scattered to the two end nodes.
+    """
+    n = int(p[P_NEL])
+    o = 6 * (n - 1)
+    L = x[o + 12]
+    l_u = L / n
+    il_u = 1.0 / l_u
+    rate = x[o + 13] / L  # Ldot / L: the strain rate's unstretched-length term
+    m_node = p[P_MU] * l_u
+    EA, cs = p[P_EA], p[P_DASHPOT]
+    qd = 0.5 * p[P_RHO] * p[P_CDN] * p[P_DIAM] * l_u
+    f0, f1, f2, f3, f4 = p[P_FN], p[P_FN + 1], p[P_FN + 2], p[P_FN + 3], p[P_FN + 4]
+    t0, t1, t2, t3, t4, t5 = p[P_FT], p[P_FT + 1], p[P_FT + 2], p[P_FT + 3], p[P_FT + 4], p[P_FT + 5]
+    P, V, F, T0 = 0, 3 * (n + 1), 6 * (n + 1), 9 * (n + 1)
+    WN = _pts(n) + 3 * (n + 1 + int(p[P_NFIN]))
+    # element pass; the upper node's force (-T e + D/2) goes to the F slots of node e+1 for now
+    for e in range(n):
+        a = 3 * e
+        dx = w[P + a] - w[P + a + 3]
+        dy = w[P + a + 1] - w[P + a + 4]
+        dz = w[P + a + 2] - w[P + a + 5]
+        ln = math.sqrt(dx * dx + dy * dy + dz * dz)
+        il = 1.0 / ln
+        ex, ey, ez = dx * il, dy * il, dz * il
+        # tension only: a slack element carries nothing, and damping cannot push
+        T = EA * (ln * il_u - 1.0) + cs * (ex * (w[V + a] - w[V + a + 3]) + ey * (w[V + a + 1] - w[V + a + 4])
+                                         + ez * (w[V + a + 2] - w[V + a + 5]) - ln * rate)
+        T = max(T, 0.0) if ln > l_u else 0.0
+        w[T0 + e] = T
+        # Morison drag with loading functions, from the midpoint velocity relative to the air:
+        # D = q |v|^2 [f_n(phi) (-v_n/|v_n|) + f_t(phi) (-sign(v.e) e)], phi in [0, pi/2]
+        vx = 0.5 * (w[V + a] + w[V + a + 3]) - w[WN + a]
+        vy = 0.5 * (w[V + a + 1] + w[V + a + 4]) - w[WN + a + 1]
+        vz = 0.5 * (w[V + a + 2] + w[V + a + 5]) - w[WN + a + 2]
+        vt = vx * ex + vy * ey + vz * ez
+        nx, ny, nz = vx - vt * ex, vy - vt * ey, vz - vt * ez  # normal component, one definition
+        vn2 = nx * nx + ny * ny + nz * nz
+        v2 = vt * vt + vn2
+        at = abs(vt)
+        vn = math.sqrt(vn2)
+        ivm = 1.0 / max(math.sqrt(v2), 1e-150)
+        c, s = at * ivm, vn * ivm
+        r = _atan01(min(at, vn) / max(at, vn, 1e-150))
+        phi = r if vn <= at else 0.5 * math.pi - r
+        fn = f0 + f1 * c + f2 * s + f3 * (2.0 * c * c - 1.0) + f4 * 2.0 * s * c
+        ft = t0 + phi * (t1 + phi * (t2 + phi * (t3 + phi * (t4 + phi * t5))))
+        kn = -qd * v2 * fn / vn if vn > 0.0 else 0.0
+        kt = -qd * v2 * ft * (1.0 if vt > 0.0 else -1.0)
+        Dx = kn * nx + kt * ex
+        Dy = kn * ny + kt * ey
+        Dz = kn * nz + kt * ez
+        w[F + a] = T * ex + 0.5 * Dx  # force on the lower node, stored at its index below
+        w[F + a + 1] = T * ey + 0.5 * Dy
+        w[F + a + 2] = T * ez + 0.5 * Dz
+        w[WN + a] = -T * ex + 0.5 * Dx  # force on the upper node (wind slot no longer needed)
+        w[WN + a + 1] = -T * ey + 0.5 * Dy
+        w[WN + a + 2] = -T * ez + 0.5 * Dz
+    # scatter: node j gets the lower-node force of element j-1 and the upper-node force of
+    # element j, plus gravity (full node mass inside, half an element at the confluence point)
+    g = m_node * p[P_G]
+    for j in range(n, -1, -1):
+        fx = w[F + 3 * j - 3] if j > 0 else 0.0
+        fy = w[F + 3 * j - 2] if j > 0 else 0.0
+        fz = w[F + 3 * j - 1] if j > 0 else 0.0
+        if j < n:
+            fx += w[WN + 3 * j]
+            fy += w[WN + 3 * j + 1]
+            fz += w[WN + 3 * j + 2]
+        w[F + 3 * j] = fx
+        w[F + 3 * j + 1] = fy
+        w[F + 3 * j + 2] = fz - (0.5 * g if j == 0 else g)
+    return w[T0 + n - 1]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def tether_forces(t, x, p, wp, wf, R, w):
+    """Kinematics, winds, tensions and node forces; returns the winch-end element tension."""
+    npts = _kinematics(x, p, R, w)
+    wind_batch(t, w, npts, _pts(int(p[P_NEL])), wp, wf)
+    return _tether(x, p, w)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _hull(u, v, wv, p):
+    """Jones & DeLaurier hull force (body) and nose moment vector from air-relative velocity.
+
+    alpha = acos(u / V), crossflow Vc = sqrt(v^2 + w^2); lift opposes the crossflow:
+    F = [-D_h, -L_h v / Vc, -L_h w / Vc]. L_h / Vc and M_nose / Vc are evaluated in closed form
+    so alpha -> 0 has no 0/0. The nose moment (positive nose-up) acts about x_hat x lift_hat.
+    """
+    V2 = u * u + v * v + wv * wv
+    if V2 < 1e-20:
+        return 0.0, 0.0, 0.0, 0.0, 0.0
+    V = math.sqrt(V2)
+    q0 = 0.5 * p[P_RHO] * V2
+    ca = u / V
+    sa = math.sqrt(v * v + wv * wv) / V
+    c2 = math.sqrt(max(0.0, 0.5 * (1.0 + ca)))  # cos(alpha/2)
+    s2 = math.sqrt(max(0.0, 0.5 * (1.0 - ca)))  # sin(alpha/2)
+    kp = p[P_KPOT]
+    # drag along -x: axial friction (sign follows u) minus the axial part of the potential force
+    D = q0 * (p[P_CD0H] * p[P_SH] * ca * abs(ca) - kp * p[P_I1] * 2.0 * sa * ca * s2)
+    # lift and nose moment per unit crossflow speed (divide sin(alpha) by Vc = V sin(alpha))
+    Lc = q0 / V * (kp * p[P_I1] * 2.0 * ca * c2 + p[P_CDC] * p[P_J1] * sa)
+    Mc = -q0 / V * (kp * p[P_I3] * 2.0 * ca * c2 + p[P_CDC] * p[P_J2] * sa)
+    # force components; moment about x_hat x lift_hat = (0, w, -v)/Vc, times M_nose
+    return -D, -Lc * v, -Lc * wv, Mc * wv, -Mc * v
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _fin(u, v, wv, p, i):
+    """Lift and drag of fin i (body frame) from its air-relative velocity (u, v, w)."""
+    b = P_FIN + 9 * i
+    nx, ny, nz = p[b + 6], p[b + 7], p[b + 8]
+    un = u  # chordwise component (body x)
+    wn = u * nx + v * ny + wv * nz  # normal to the fin plane
+    V2 = u * u + v * v + wv * wv
+    if V2 < 1e-20:
+        return 0.0, 0.0, 0.0
+    alpha = fast_atan2(wn, un)
+    a_st = p[P_ASTALL]
+    cla = p[P_CLA]
+    cl = cla * min(max(alpha, -a_st), a_st)  # flat beyond stall
+    cd = p[P_CD0F] + cla * cla * alpha * alpha * p[P_KIND]  # induced drag from the unsaturated C_L
+    q = 0.5 * p[P_RHO] * p[P_AF] * V2
+    qin = math.sqrt(un * un + wn * wn)
+    fx = fy = fz = 0.0
+    if qin > 1e-12:
+        # lift perpendicular to the in-plane velocity, against the crossflow:
+        # F_L = L (sin(alpha) x_hat - cos(alpha) n_hat)
+        sal, cal = wn / qin, un / qin
+        lift = q * cl
+        fx += lift * sal - lift * cal * nx
+        fy += -lift * cal * ny
+        fz += -lift * cal * nz
+    # drag opposes the full 3-D air-relative velocity (spanwise flow included, as in [LN02])
+    kd = -q * cd / math.sqrt(V2)
+    return fx + kd * u, fy + kd * v, fz + kd * wv
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def rhs(t, x, u, p, wp, wf, dx, w):
+    """State derivative dx = f(t, x, u) of the full model (see module docstring).
+
+    Parameters
+    ----------
+    t : float, time [s]. x : state (layout in :mod:`aerostat_gym.physics.layout`).
+    u : [reel-out speed set-point (m/s), brake flag]. p : packed parameters.
+    wp, wf : wind parameter vector and turbulence field (:mod:`aerostat_gym.physics.wind`).
+    dx : output array, same size as x. w : work array of ``work_size(n)`` floats; on return it
+    holds node positions, velocities, forces and element tensions.
+    """
+    n = int(p[P_NEL])
+    nm = n - 1
+    o = 6 * nm
+    R = _rotation(x[o + 6], x[o + 7], x[o + 8])
+    Tw = tether_forces(t, x, p, wp, wf, R, w)
+    F = 6 * (n + 1)
+    L = x[o + 12]
+    m_node = p[P_MU] * L / n
+    for j in range(nm):
+        for k in range(3):
+            dx[3 * j + k] = x[3 * nm + 3 * j + k]
+            dx[3 * nm + 3 * j + k] = w[F + 3 * (j + 1) + k] / m_node
+    _aerostat(x, p, w, R, w[F], w[F + 1], w[F + 2], dx, o)
+    if p[P_FIXED] != 0.0:
+        for k in range(12):
+            dx[o + k] = 0.0
+    _winch(x, u, p, Tw, dx, o)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _aerostat(x, p, w, R, flx, fly, flz, dx, o):
+    """Aerostat rigid-body derivatives; (flx, fly, flz) is the tether force at the leash (inertial)
+    and the winds at the hull and fin points are read from the work array."""
+    n = int(p[P_NEL])
+    nf = int(p[P_NFIN])
+    R00, R01, R02, R10, R11, R12, R20, R21, R22, cph, sph, cth, sth = R
+    vx, vy, vz = x[o + 3], x[o + 4], x[o + 5]
+    pp, qq, rr = x[o + 9], x[o + 10], x[o + 11]
+    # body components of the CM velocity
+    ub = R00 * vx + R10 * vy + R20 * vz
+    vb = R01 * vx + R11 * vy + R21 * vz
+    wb = R02 * vx + R12 * vy + R22 * vz
+    g, m, B = p[P_G], p[P_MASS], p[P_BUOY]
+    # body components of inertial up (z_hat)
+    zx, zy, zz = R20, R21, R22
+    # gravity at the CM, buoyancy at the CB, tether at the leash point
+    Fx = (B - m * g) * zx + R00 * flx + R10 * fly + R20 * flz
+    Fy = (B - m * g) * zy + R01 * flx + R11 * fly + R21 * flz
+    Fz = (B - m * g) * zz + R02 * flx + R12 * fly + R22 * flz
+    xb, yb, zb = p[P_CB], p[P_CB + 1], p[P_CB + 2]
+    Mx = yb * B * zz - zb * B * zy
+    My = zb * B * zx - xb * B * zz
+    Mz = xb * B * zy - yb * B * zx
+    xl, yl, zl = p[P_LEASH], p[P_LEASH + 1], p[P_LEASH + 2]
+    fbx = R00 * flx + R10 * fly + R20 * flz
+    fby = R01 * flx + R11 * fly + R21 * flz
+    fbz = R02 * flx + R12 * fly + R22 * flz
+    Mx += yl * fbz - zl * fby
+    My += zl * fbx - xl * fbz
+    Mz += xl * fby - yl * fbx
+    # hull: air-relative velocity at the centre of buoyancy (the hull's volume centroid)
+    WA = _pts(n) + 3 * (2 * n + 1 + nf)  # wind at the hull point, then at each fin
+    hx, hy, hz = _air_body(ub, vb, wb, pp, qq, rr, xb, yb, zb, R, w[WA], w[WA + 1], w[WA + 2])
+    hfx, hfy, hfz, hmy, hmz = _hull(hx, hy, hz, p)
+    xn, yn, zn = p[P_NOSE], p[P_NOSE + 1], p[P_NOSE + 2]
+    Fx += hfx
+    Fy += hfy
+    Fz += hfz
+    Mx += yn * hfz - zn * hfy
+    My += zn * hfx - xn * hfz + hmy
+    Mz += xn * hfy - yn * hfx + hmz
+    for i in range(nf):
+        b = P_FIN + 9 * i
+        cx, cy, cz = p[b], p[b + 1], p[b + 2]
+        k = WA + 3 * (i + 1)
+        fu, fv, fw = _air_body(ub, vb, wb, pp, qq, rr, cx, cy, cz, R, w[k], w[k + 1], w[k + 2])
+        ffx, ffy, ffz = _fin(fu, fv, fw, p, i)
+        Fx += ffx
+        Fy += ffy
+        Fz += ffz
+        Mx += cy * ffz - cz * ffy
+        My += cz * ffx - cx * ffz
+        Mz += cx * ffy - cy * ffx
+    # Kirchhoff inertial terms: M_e a_B = F + M_a (omega x V) - omega x (M_a V)
+    max_, may, maz = p[P_MA], p[P_MA + 1], p[P_MA + 2]
+    ox, oy, oz = qq * wb - rr * vb, rr * ub - pp * wb, pp * vb - qq * ub  # omega x V
+    Pax, Pay, Paz = max_ * ub, may * vb, maz * wb  # M_a V
+    gx = max_ * ox - (qq * Paz - rr * Pay)
+    gy = may * oy - (rr * Pax - pp * Paz)
+    gz = maz * oz - (pp * Pay - qq * Pax)
+    abx = (Fx + gx) / p[P_ME]
+    aby = (Fy + gy) / p[P_ME + 1]
+    abz = (Fz + gz) / p[P_ME + 2]
+    for k in range(3):
+        dx[o + k] = x[o + 3 + k]
+    dx[o + 3] = R00 * abx + R01 * aby + R02 * abz
+    dx[o + 4] = R10 * abx + R11 * aby + R12 * abz
+    dx[o + 5] = R20 * abx + R21 * aby + R22 * abz
+    # rotation: I domega = M - omega x (I omega) - V x (M_a V)
+    I = P_INERTIA
+    Lx = p[I] * pp + p[I + 1] * qq + p[I + 2] * rr
+    Ly = p[I + 3] * pp + p[I + 4] * qq + p[I + 5] * rr
+    Lz = p[I + 6] * pp + p[I + 7] * qq + p[I + 8] * rr
+    Mx -= qq * Lz - rr * Ly + (vb * Paz - wb * Pay)
+    My -= rr * Lx - pp * Lz + (wb * Pax - ub * Paz)
+    Mz -= pp * Ly - qq * Lx + (ub * Pay - vb * Pax)
+    J = P_IINV
+    dx[o + 9] = p[J] * Mx + p[J + 1] * My + p[J + 2] * Mz
+    dx[o + 10] = p[J + 3] * Mx + p[J + 4] * My + p[J + 5] * Mz
+    dx[o + 11] = p[J + 6] * Mx + p[J + 7] * My + p[J + 8] * Mz
+    # Z-Y-X Euler kinematics
+    tth = sth / cth
+    dx[o + 6] = pp + (qq * sph + rr * cph) * tth
+    dx[o + 7] = qq * cph - rr * sph
+    dx[o + 8] = (qq * sph + rr * cph) / cth
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _air_body(ub, vb, wb, pp, qq, rr, cx, cy, cz, R, ax, ay, az):
+    """Body-frame velocity relative to the air of the body point c: V + omega x c - R^T W,
+    with W = (ax, ay, az) the inertial air velocity at that point."""
+    R00, R01, R02, R10, R11, R12, R20, R21, R22 = R[0], R[1], R[2], R[3], R[4], R[5], R[6], R[7], R[8]
+    u = ub + qq * cz - rr * cy - (R00 * ax + R10 * ay + R20 * az)
+    v = vb + rr * cx - pp * cz - (R01 * ax + R11 * ay + R21 * az)
+    w = wb + pp * cy - qq * cx - (R02 * ax + R12 * ay + R22 * az)
+    return u, v, w
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _winch(x, u, p, Tw, dx, o):
+    """Winch: L' = v_w; speed loop v_w' = clip((clip(v_set) - v_w)/tau, +-a_max) realised by a
+    motor force on the reflected drivetrain m_eq v_w' = T + F_m - F_c sgn(v_w) - c_v v_w with
+    |F_m| <= F_max. The brake (u[1] != 0) holds the drum: both derivatives zero."""
+    L, v = x[o + 12], x[o + 13]
+    if u[1] != 0.0:
+        dx[o + 12] = 0.0
+        dx[o + 13] = 0.0
+        return
+    vmax = p[P_W_VMAX]
+    vs = min(max(u[0], -vmax), vmax)
+    if (L <= p[P_W_LMIN] and vs < 0.0) or (L >= p[P_W_LMAX] and vs > 0.0):
+        vs = 0.0  # length limits: the drum stops paying in/out
+    a_des = min(max((vs - v) / p[P_W_TAU], -p[P_W_AMAX]), p[P_W_AMAX])
+    m_eq = p[P_W_MEQ]
+    fr = p[P_W_FC] * math.tanh(v / p[P_W_FRICTION_V]) + p[P_W_CV] * v
+    Fm = min(max(m_eq * a_des - Tw + fr, -p[P_W_FMAX]), p[P_W_FMAX])
+    dx[o + 12] = v
+    dx[o + 13] = (Tw + Fm - fr) / m_eq
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def evaluate_tether(t, x, p, wp, wf, w):
+    """Fill the work array (node kinematics, forces, tensions) for state x; returns the
+    winch-end element tension. Used for outputs; :func:`rhs` does the same internally."""
+    o = 6 * (int(p[P_NEL]) - 1)
+    R = _rotation(x[o + 6], x[o + 7], x[o + 8])
+    return tether_forces(t, x, p, wp, wf, R, w)

@@ -1,0 +1,236 @@
+"""State layout and the packed parameter vector of the compiled core.
+
+State vector (length 6 n + 8, n = number of tether elements)::
+
+    [ r_2 .. r_n        3 (n-1)  inertial positions of the moving tether nodes, top to bottom [m]
+      v_2 .. v_n        3 (n-1)  their inertial velocities [m/s]
+      r_cm              3        aerostat CM position, inertial [m]
+      v_cm              3        aerostat CM velocity, inertial components [m/s]
+      phi, theta, psi   3        Z-Y-X Euler angles (roll, pitch, yaw) [rad]
+      p, q, r           3        body angular rates [rad/s]
+      L                 1        unstretched tether length paid out [m]
+      v_w               1        winch reel-out speed (positive pays line out) [m/s] ]
+
+The first 6 n + 6 entries are the mechanical state of [LN02] (66 for n = 10); the last two are
+the winch. Node numbering follows [LN02]: node 1 is the confluence point, rigidly attached to
+the aerostat (not a state), node n + 1 the anchor at the winch (fixed, not a state).
+
+Control input ``u = [v_set, brake]``: reel-out speed set-point [m/s] and brake flag (1 holds the
+drum). The packed parameter vector is a flat float64 array indexed by the constants below, so
+the compiled functions take plain arrays and numba folds the indices at compile time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..params import Params
+
+MAX_FINS = 6
+N_INPUTS = 2
+U_SPEED, U_BRAKE = 0, 1
+
+# --- packed parameter vector ----------------------------------------------------------------------
+_FIELDS = [
+    ("G", 1), ("RHO", 1), ("MASS", 1), ("BUOY", 1), ("ME", 3), ("MA", 3), ("INERTIA", 9),
+    ("IINV", 9), ("CB", 3), ("LEASH", 3), ("NOSE", 3),
+    # hull (Jones & DeLaurier)
+    ("KPOT", 1), ("I1", 1), ("I3", 1), ("J1", 1), ("J2", 1), ("CD0H", 1), ("SH", 1), ("CDC", 1),
+    # fins
+    ("NFIN", 1), ("AF", 1), ("CLA", 1), ("ASTALL", 1), ("CD0F", 1), ("KIND", 1),
+    ("FIN", 9 * MAX_FINS),
+    # tether
+    ("NEL", 1), ("EA", 1), ("MU", 1), ("DASHPOT", 1), ("CDN", 1), ("DIAM", 1), ("FN", 5),
+    ("FT", 6), ("ANCHOR", 3), ("STRENGTH", 1),
+    # winch
+    ("W_MEQ", 1), ("W_FC", 1), ("W_CV", 1), ("W_FMAX", 1), ("W_VMAX", 1), ("W_AMAX", 1),
+    ("W_TAU", 1), ("W_LMIN", 1), ("W_LMAX", 1), ("W_FRICTION_V", 1),
+    # 1 holds the aerostat fixed (tether-only runs, e.g. the comparison with MoorDyn)
+    ("FIXED", 1),
+]
+# Offsets into the packed vector (literal, so numba folds them; checked against _FIELDS by the tests).
+P_G = 0
+P_RHO = 1
+P_MASS = 2
+P_BUOY = 3
+P_ME = 4
+P_MA = 7
+P_INERTIA = 10
+P_IINV = 19
+P_CB = 28
+P_LEASH = 31
+P_NOSE = 34
+P_KPOT = 37
+P_I1 = 38
+P_I3 = 39
+P_J1 = 40
+P_J2 = 41
+P_CD0H = 42
+P_SH = 43
+P_CDC = 44
+P_NFIN = 45
+P_AF = 46
+P_CLA = 47
+P_ASTALL = 48
+P_CD0F = 49
+P_KIND = 50
+P_FIN = 51
+P_NEL = 105
+P_EA = 106
+P_MU = 107
+P_DASHPOT = 108
+P_CDN = 109
+P_DIAM = 110
+P_FN = 111
+P_FT = 116
+P_ANCHOR = 122
+P_STRENGTH = 125
+P_W_MEQ = 126
+P_W_FC = 127
+P_W_CV = 128
+P_W_FMAX = 129
+P_W_VMAX = 130
+P_W_AMAX = 131
+P_W_TAU = 132
+P_W_LMIN = 133
+P_W_LMAX = 134
+P_W_FRICTION_V = 135
+P_FIXED = 136
+P_SIZE = 137
+
+
+def pack_params(params: Params) -> np.ndarray:
+    """Flatten :class:`Params` (plus derived quantities) into the compiled core's vector."""
+    env, a, h, f, t, w = (params.environment, params.aerostat, params.hull, params.fins,
+                          params.tether, params.winch)
+    d = params.derived
+    if len(f.panels) > MAX_FINS:
+        raise ValueError(f"at most {MAX_FINS} fin panels are supported, got {len(f.panels)}")
+    p = np.zeros(P_SIZE)
+    p[P_G], p[P_RHO], p[P_MASS], p[P_BUOY] = env.g, env.rho_air, a.mass, d.buoyancy
+    p[P_ME:P_ME + 3] = d.effective_mass
+    p[P_MA:P_MA + 3] = d.added_mass
+    inertia = np.array([[a.Ixx, 0.0, -a.Ixz], [0.0, a.Iyy, 0.0], [-a.Ixz, 0.0, a.Izz]])
+    # Inertia tensor with the product of inertia Ixz = integral(x z dm): the off-diagonal entry of
+    # the tensor is -Ixz (standard rigid-body convention, [LN02] eq. for M_cm).
+    p[P_INERTIA:P_INERTIA + 9] = inertia.ravel()
+    p[P_IINV:P_IINV + 9] = np.linalg.inv(inertia).ravel()
+    p[P_CB:P_CB + 3] = a.cb_position
+    p[P_LEASH:P_LEASH + 3] = d.leash_position
+    p[P_NOSE:P_NOSE + 3] = a.nose_position
+    p[P_KPOT] = (a.k3 - a.k1) * h.eta_k
+    p[P_I1], p[P_I3], p[P_J1], p[P_J2] = h.I1, h.I3, h.J1, h.J2
+    p[P_CD0H], p[P_SH], p[P_CDC] = h.CD0, d.reference_area, h.Cdc
+    p[P_NFIN] = len(f.panels)
+    p[P_AF], p[P_CLA], p[P_ASTALL], p[P_CD0F] = (f.planform_area, f.CL_alpha,
+                                                 math.radians(f.alpha_stall_deg), f.CD0)
+    p[P_KIND] = 1.0 / (math.pi * f.aspect_ratio * f.oswald_e)
+    for i, pan in enumerate(f.panels):
+        g = math.radians(pan.roll_angle_deg)
+        span = np.array([0.0, math.sin(g), math.cos(g)])
+        normal = np.cross(span, [1.0, 0.0, 0.0])  # n = s x x: fin-plane normal ([LN02] fin alpha)
+        p[P_FIN + 9 * i:P_FIN + 9 * i + 9] = np.concatenate([pan.cp_position, span, normal])
+    p[P_NEL], p[P_EA], p[P_MU], p[P_DASHPOT] = t.n_elements, d.EA, d.mass_per_length, d.dashpot
+    p[P_CDN], p[P_DIAM] = t.Cd_normal, t.diameter
+    if len(t.loading_fn) != 5:
+        raise ValueError(f"tether.loading_fn needs 5 coefficients, got {len(t.loading_fn)}")
+    if len(t.loading_ft) != 6:
+        raise ValueError(f"tether.loading_ft needs 6 coefficients, got {len(t.loading_ft)}")
+    p[P_FN:P_FN + 5] = t.loading_fn
+    p[P_FT:P_FT + 6] = t.loading_ft
+    p[P_ANCHOR:P_ANCHOR + 3] = t.anchor_position
+    p[P_STRENGTH] = t.strength
+    p[P_W_MEQ], p[P_W_FC], p[P_W_CV] = w.equivalent_mass, w.coulomb_friction, w.viscous_friction
+    p[P_W_FMAX], p[P_W_VMAX], p[P_W_AMAX] = w.max_motor_force, w.max_speed, w.max_acceleration
+    p[P_W_TAU], p[P_W_LMIN], p[P_W_LMAX] = w.speed_time_constant, w.min_length, w.max_length
+    p[P_W_FRICTION_V] = 0.01  # m/s: Coulomb friction smoothed as tanh(v / 0.01)
+    return p
+
+
+@dataclass(frozen=True)
+class StateLayout:
+    """Named slices into the flat state vector for n tether elements (see module docstring)."""
+
+    n_elements: int
+
+    @property
+    def n_nodes(self) -> int:
+        """Moving tether nodes (excludes the confluence point and the anchor)."""
+        return self.n_elements - 1
+
+    @property
+    def size(self) -> int:
+        return 6 * self.n_elements + 8
+
+    @property
+    def n_mechanical(self) -> int:
+        return 6 * self.n_elements + 6
+
+    def _a(self, k: int) -> int:
+        return 6 * self.n_nodes + k
+
+    @property
+    def node_pos(self) -> slice:
+        return slice(0, 3 * self.n_nodes)
+
+    @property
+    def node_vel(self) -> slice:
+        return slice(3 * self.n_nodes, 6 * self.n_nodes)
+
+    @property
+    def cm_pos(self) -> slice:
+        return slice(self._a(0), self._a(3))
+
+    @property
+    def cm_vel(self) -> slice:
+        return slice(self._a(3), self._a(6))
+
+    @property
+    def euler(self) -> slice:
+        return slice(self._a(6), self._a(9))
+
+    @property
+    def rates(self) -> slice:
+        return slice(self._a(9), self._a(12))
+
+    @property
+    def winch_length(self) -> int:
+        return self._a(12)
+
+    @property
+    def winch_speed(self) -> int:
+        return self._a(13)
+
+    @property
+    def mechanical(self) -> slice:
+        return slice(0, self.n_mechanical)
+
+    def names(self) -> list[str]:
+        """Human-readable name of every state entry (node k counts from the top, k = 2..n)."""
+        out = []
+        nodes = range(2, self.n_elements + 1)
+        out += [f"{c}{k}" for k in nodes for c in "xyz"]
+        out += [f"{c}dot{k}" for k in nodes for c in "xyz"]
+        out += ["x_cm", "y_cm", "z_cm", "u_cm", "v_cm", "w_cm", "phi", "theta", "psi", "p", "q", "r"]
+        return out + ["L", "v_w"]
+
+    def longitudinal_indices(self) -> np.ndarray:
+        """[LN02] longitudinal set: x, z and their rates for every node (aerostat last), theta, q.
+
+        Order: x_2..x_n, x_cm, xdot_2..xdot_cm, z_2..z_cm, zdot_2..zdot_cm, theta, q
+        (4 n + 2 states).
+        """
+        n = self.n_nodes
+        pos = lambda c: [3 * k + c for k in range(n)] + [self._a(c)]  # noqa: E731
+        vel = lambda c: [3 * n + 3 * k + c for k in range(n)] + [self._a(3 + c)]  # noqa: E731
+        return np.array(pos(0) + vel(0) + pos(2) + vel(2) + [self._a(7), self._a(10)])
+
+    def lateral_indices(self) -> np.ndarray:
+        """[LN02] lateral set: y and its rate for every node, phi, p, psi, r (2 n + 4 states)."""
+        n = self.n_nodes
+        ys = [3 * k + 1 for k in range(n)] + [self._a(1)]
+        vys = [3 * n + 3 * k + 1 for k in range(n)] + [self._a(4)]
+        return np.array(ys + vys + [self._a(6), self._a(9), self._a(8), self._a(11)])

@@ -1,0 +1,130 @@
+"""Parameters: strict loading, overrides, statuses and derived quantities."""
+
+import math
+
+import pytest
+
+from aerostat_gym.params import (
+    ParameterError,
+    dumps_toml,
+    load_params,
+    parameter_table,
+    params_from_dict,
+    params_to_dict,
+)
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover
+    import tomli as tomllib
+
+
+@pytest.fixture(scope="module")
+def base():
+    return load_params()
+
+
+def test_derived_quantities_match_reference_notes(base):
+    """Derived values against docs/parameters.md (rel 1e-3): EA 1.0575e6 N, mu 0.02375 kg/m,
+    b = zeta b_c = 161.6 N s, B - mg = 2645 N, m_e = 425.3 / 771.8 kg."""
+    d = base.derived
+    assert d.EA == pytest.approx(1.0575e6, rel=1e-3)
+    assert d.mass_per_length == pytest.approx(0.02375, rel=1e-3)
+    assert d.damping_b == pytest.approx(161.6, rel=1e-3)
+    assert d.net_lift == pytest.approx(2645.0, rel=1e-3)
+    assert d.effective_mass[0] == pytest.approx(425.3, rel=1e-3)
+    assert d.effective_mass[2] == pytest.approx(771.8, rel=1e-3)
+
+
+def test_leash_from_zero_wind_moment_balance(base):
+    """x_l satisfies B (x_b cos th + z_b sin th) = (B - mg)(x_l cos th + z_l sin th) to 1e-12."""
+    d, a = base.derived, base.aerostat
+    th = math.radians(a.trim_pitch_deg)
+    xb, _, zb = a.cb_position
+    xl, _, zl = d.leash_position
+    lhs = d.buoyancy * (xb * math.cos(th) + zb * math.sin(th))
+    rhs = d.net_lift * (xl * math.cos(th) + zl * math.sin(th))
+    assert lhs == pytest.approx(rhs, abs=1e-9 * d.buoyancy)
+
+
+def test_every_value_has_a_status_and_unit(base):
+    rows = parameter_table(base)
+    assert len(rows) > 60
+    for r in rows:
+        assert r["status"] in {"SOURCED", "DERIVED", "ESTIMATE", "CALIB"}, r
+        assert r["unit"], r
+
+
+def test_round_trip_through_toml(base):
+    assert params_from_dict(tomllib.loads(dumps_toml(base))) == base
+    assert params_from_dict(params_to_dict(base)) == base
+
+
+@pytest.mark.parametrize(
+    "key, value, message",
+    [
+        ("tether.length", -1.0, "tether.length must be > 0"),
+        ("tether.diameter", 0.0, "tether.diameter must be > 0"),
+        ("aerostat.volume", 0.0, "aerostat.volume must be > 0"),
+        ("environment.rho_air", 0.0, "environment.rho_air must be > 0"),
+        ("tether.n_elements", 0, "tether.n_elements must be an integer >= 1"),
+        ("tether.n_elements", 2.5, "tether.n_elements must be an integer >= 1"),
+        ("tether.damping_ratio", -0.1, "tether.damping_ratio must be >= 0"),
+        ("fins.alpha_stall_deg", 90.0, r"fins.alpha_stall_deg must lie in \(0, 90\)"),
+        ("fins.alpha_stall_deg", 0.0, r"fins.alpha_stall_deg must lie in \(0, 90\)"),
+        ("tether.length", "long", "tether.length must be a number"),
+        ("tether.length", float("nan"), "tether.length must be finite"),
+        ("wind.profile", "cubic", "wind.profile must be one of"),
+        ("aerostat.mass", 1000.0, "gives no net lift"),
+        ("aerostat.cb_position", [1.0, 2.0], "must be a list of 3 numbers"),
+        ("tether.colour", "red", "unknown parameter 'tether.colour'"),
+        ("nonsense", 1, "unknown parameter 'nonsense'"),
+    ],
+)
+def test_invalid_values_name_the_field(base, key, value, message):
+    with pytest.raises(ParameterError, match=message):
+        base.replace(**{key: value})
+
+
+def test_unknown_key_missing_key_missing_section(base):
+    data = params_to_dict(base)
+    data["hull"]["mystery"] = 1.0
+    with pytest.raises(ParameterError, match=r"unknown key\(s\) in \[hull\]: mystery"):
+        params_from_dict(data)
+    data = params_to_dict(base)
+    del data["tether"]["strength"]
+    with pytest.raises(ParameterError, match=r"missing key\(s\) in \[tether\]: strength"):
+        params_from_dict(data)
+    data = params_to_dict(base)
+    del data["winch"]
+    with pytest.raises(ParameterError, match=r"missing section\(s\): winch"):
+        params_from_dict(data)
+    data = params_to_dict(base)
+    data["extra"] = {}
+    with pytest.raises(ParameterError, match=r"unknown section\(s\): extra"):
+        params_from_dict(data)
+
+
+def test_user_file_and_overrides(tmp_path, base):
+    f = tmp_path / "mine.toml"
+    f.write_text(dumps_toml(base).replace("length = 300.0", "length = 450.0"))
+    p = load_params(f, overrides={"tether.n_elements": 20})
+    assert p.tether.length == 450.0 and p.tether.n_elements == 20
+    assert p.derived.element_length == pytest.approx(22.5)
+    with pytest.raises(ParameterError, match="not found"):
+        load_params(tmp_path / "absent.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[tether\nlength = 3")
+    with pytest.raises(ParameterError, match="invalid TOML"):
+        load_params(bad)
+
+
+def test_packed_offsets_match_field_table():
+    """The literal P_* offsets of the packed parameter vector equal the running sum of _FIELDS."""
+    from aerostat_gym.physics import layout
+
+    off = 0
+    for name, size in layout._FIELDS:
+        assert getattr(layout, "P_" + name) == off, name
+        off += size
+    assert layout.P_SIZE == off

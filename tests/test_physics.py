@@ -1,0 +1,257 @@
+"""Physics core: closed-form limits, conservation laws, symmetry, convergence, robustness.
+
+Every assertion states its reference and tolerance.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from aerostat_gym.analysis.energy import mechanical_energy
+from aerostat_gym.analysis.signals import zero_crossing_period
+from aerostat_gym.analysis.trim import TrimError, find_equilibrium
+from aerostat_gym.params import load_params
+from aerostat_gym.simulation import Model, SimulationError, simulate
+
+AERO_OFF = {"hull.CD0": 0.0, "hull.Cdc": 0.0, "hull.eta_k": 0.0, "fins.CL_alpha": 0.0,
+            "fins.CD0": 0.0, "tether.Cd_normal": 0.0, "tether.damping_ratio": 0.0}
+
+
+@pytest.fixture(scope="module")
+def base():
+    return load_params()
+
+
+@pytest.fixture(scope="module")
+def trim0(base):
+    return find_equilibrium(base, 0.0)
+
+
+def test_zero_wind_trim_closed_form(base, trim0):
+    """Zero wind: vertical tether, top tension B - mg, bottom B - mg - tether weight (rel 1e-6),
+    pitch = configured trim pitch (1e-6 rad)."""
+    d, s = base.derived, trim0.summary
+    assert s["blow_by_deg"] < 1e-6
+    assert s["top_tension_N"] == pytest.approx(d.net_lift, rel=1e-6)
+    assert s["bottom_tension_N"] == pytest.approx(d.net_lift - d.tether_weight, rel=1e-6)
+    assert abs(math.radians(s["pitch_deg"]) - math.radians(base.aerostat.trim_pitch_deg)) < 1e-6
+    assert trim0.residual <= 1e-9
+
+
+def test_zero_wind_is_a_fixed_point(base, trim0):
+    """The zero-wind trim is a fixed point of the full RHS: every acceleration below 1e-8 m/s^2."""
+    dx = Model(base, 0.0).rhs(trim0.x)
+    assert np.max(np.abs(dx)) < 1e-8
+
+
+def test_energy_conserved_without_dissipation():
+    """Drag, aerodynamics and tether damping off, winch braked: the total mechanical energy
+    (kinetic with added mass, gravity, buoyancy, elastic) drifts by < 1e-6 of the perturbation
+    energy over 60 s with RK4 at dt = 0.25 ms (a far stricter measure than relative to |E|).
+    The small step matters: RK4 damps the highest tether mode (440 rad/s) by (omega h)^6 / 72
+    per step, which at the default 5 ms step dissipates the few 1e-6 of the perturbation energy
+    that the initial kick puts into those modes."""
+    p = load_params(overrides=AERO_OFF)
+    eq = find_equilibrium(p, 0.0)
+    m = Model(p, 0.0)
+    lay = m.layout
+    x0 = eq.x.copy()
+    x0[lay.cm_vel] = [0.3, 0.2, 0.05]
+    x0[lay.rates] = [0.01, 0.02, 0.01]
+    e_eq, e0 = mechanical_energy(m, eq.x), mechanical_energy(m, x0)
+    tr = simulate(p, x0, 60.0, wind=0.0, dt=2.5e-4, output_dt=1.0, model=m)
+    drift = max(abs(mechanical_energy(m, s) - e0) for s in tr.states)
+    assert tr.status == "ok"
+    assert drift / (e0 - e_eq) < 1e-6, drift / (e0 - e_eq)
+    assert drift / abs(e0) < 1e-9
+
+
+def test_energy_decays_with_damping(base, trim0):
+    """With tether damping and aerodynamics on, the perturbation energy decreases (monotone
+    trend: last value below 90 % of the first)."""
+    m = Model(base, 0.0)
+    x0 = trim0.x.copy()
+    x0[m.layout.cm_vel] = [0.3, 0.2, 0.05]
+    tr = simulate(base, x0, 60.0, wind=0.0, output_dt=5.0, model=m)
+    e = np.array([mechanical_energy(m, s) for s in tr.states]) - mechanical_energy(m, trim0.x)
+    assert e[-1] < 0.9 * e[0]
+
+
+def test_mirror_symmetry(base):
+    """Mirror-image lateral perturbations (y, v, roll, yaw, p, r negated) give mirror-image
+    trajectories at U = 10 m/s: lateral states opposite, longitudinal equal, to 1e-9."""
+    eq = find_equilibrium(base, 10.0)
+    lay = Model(base).layout
+    lat = lay.lateral_indices()
+    xa = eq.x.copy()
+    xa[lay.cm_pos.start + 1] += 0.3
+    xa[lay.euler.start] += 0.02
+    xa[lay.rates.start + 2] += 0.01
+    xb = eq.x.copy()
+    xb[lat] = 2 * eq.x[lat] - xa[lat]
+    ta = simulate(base, xa, 20.0, wind=10.0, output_dt=1.0)
+    tb = simulate(base, xb, 20.0, wind=10.0, output_dt=1.0)
+    # mirror about the trim: lateral deviations opposite (yaw about pi), longitudinal equal
+    dev_a = ta.states[:, lat] - eq.x[lat]
+    dev_b = tb.states[:, lat] - eq.x[lat]
+    np.testing.assert_allclose(dev_a, -dev_b, atol=1e-9)
+    lon = lay.longitudinal_indices()
+    np.testing.assert_allclose(ta.states[:, lon], tb.states[:, lon], atol=1e-9)
+    assert np.max(np.abs(dev_a[:, 0])) > 1e-3  # the perturbation really moved the tether
+
+
+def _periods(length, n=10, integrator="rk4"):
+    p = load_params(overrides={"tether.length": length, "tether.n_elements": n})
+    eq = find_equilibrium(p, 0.0)
+    lay = Model(p).layout
+    x = eq.x.copy()
+    x[lay.cm_pos.start] += 0.5
+    tr = simulate(p, x, 240.0, wind=0.0, output_dt=0.1, integrator=integrator)
+    pend = zero_crossing_period(tr.time, tr.cm_pos[:, 0])
+    x = eq.x.copy()
+    x[lay.cm_vel.start + 2] += 0.01
+    tr = simulate(p, x, 30.0, wind=0.0, output_dt=0.01, integrator=integrator)
+    axial = zero_crossing_period(tr.time, tr.cm_pos[:, 2])
+    return p, pend, axial
+
+
+def test_free_decay_periods_match_paper_theory():
+    """U = 0, L = 300 m: pendulum within 3 % of [LN02] Table 2 theory 43.9 s, axial spring
+    within 3 % of 2.96 s."""
+    _, pend, axial = _periods(300.0)
+    assert pend == pytest.approx(43.9, rel=0.03), pend
+    assert axial == pytest.approx(2.96, rel=0.03), axial
+
+
+@pytest.mark.parametrize("length", [150.0, 600.0])
+def test_free_decay_periods_scale_with_length(length):
+    """The same formulas at L = 150 and 600 m: axial spring 2 pi sqrt(m_ez L / EA) within 1 %;
+    pendulum 2 pi sqrt(m_ex L_eff / (B - mg)) within 3 %, with L_eff = L + |z_l| (the
+    confluence point hangs 11.55 m below the CM, so the pendulum is that much longer)."""
+    p, pend, axial = _periods(length)
+    d = p.derived
+    t_axial = 2 * math.pi * math.sqrt(d.effective_mass[2] * length / d.EA)
+    t_pend = 2 * math.pi * math.sqrt(d.effective_mass[0] * (length + abs(p.aerostat.leash_z)) / d.net_lift)
+    assert axial == pytest.approx(t_axial, rel=0.01), (axial, t_axial)
+    assert pend == pytest.approx(t_pend, rel=0.03), (pend, t_pend)
+
+
+def test_trim_exists_for_every_speed(base):
+    """Trim converges (relative residual <= 1e-9) for U = 0 ... 25 m/s in 0.5 m/s steps, each
+    continued from the previous one; blow-by grows with wind speed."""
+    eq, blow = None, []
+    for u in np.arange(0.0, 25.01, 0.5):
+        eq = find_equilibrium(base, float(u), guess=eq)
+        assert eq.residual <= 1e-9
+        blow.append(eq.summary["blow_by_deg"])
+    assert np.all(np.diff(blow[1:]) > 0)
+
+
+def test_trim_from_scratch_equals_continued(base):
+    """A single call at 12 m/s (internal continuation from zero wind) reaches the same state as
+    the sweep, to 1e-6 m."""
+    a = find_equilibrium(base, 12.0)
+    b = find_equilibrium(base, 12.0, guess=find_equilibrium(base, 11.0))
+    np.testing.assert_allclose(a.x, b.x, atol=1e-6)
+
+
+def test_convergence_in_number_of_elements():
+    """n = 5, 10, 20, 40 at U = 10 m/s: the aerostat trim position settles, each refinement
+    changing it less than the previous one; the pendulum and axial periods at U = 0 also."""
+    pos, pend, axial = [], [], []
+    for n in (5, 10, 20, 40):
+        p = load_params(overrides={"tether.n_elements": n})
+        pos.append(find_equilibrium(p, 10.0).x[Model(p).layout.cm_pos])
+        if n <= 20:
+            _, tp, ta = _periods(300.0, n, integrator="semi-implicit")
+            pend.append(tp)
+            axial.append(ta)
+    d = [np.linalg.norm(pos[i + 1] - pos[i]) for i in range(3)]
+    assert d[0] > d[1] > d[2], d
+    assert d[2] < 0.05  # metres, at n = 20 -> 40
+    assert abs(pend[2] - pend[1]) < abs(pend[1] - pend[0]) + 0.05  # s (sampling resolution)
+    assert abs(axial[2] - axial[1]) <= abs(axial[1] - axial[0]) + 0.01
+
+
+def test_hull_zero_alpha_limit_is_finite(base, trim0):
+    """alpha -> 0 (body aligned with the flow) gives finite forces: no 0/0 in the hull terms."""
+    p = base.replace(**{"aerostat.trim_pitch_deg": 0.0})
+    m = Model(p, 10.0)
+    x = find_equilibrium(p, 0.0).x.copy()
+    x[m.layout.euler] = [0.0, 0.0, math.pi]
+    assert np.all(np.isfinite(m.rhs(x)))
+
+
+def test_semi_implicit_tracks_rk4(base):
+    """Semi-implicit (dt = 0.05 s) against RK4 over 60 s at U = 10 m/s from a 1 m, 0.02 rad
+    perturbation: aerostat position within 0.1 m and attitude within 0.01 rad (first-order
+    method; measured figures are printed by `aerostat-gym bench`)."""
+    eq = find_equilibrium(base, 10.0)
+    lay = Model(base).layout
+    x = eq.x.copy()
+    x[lay.cm_pos.start] += 1.0
+    x[lay.euler.start + 1] += 0.02
+    a = simulate(base, x, 60.0, wind=10.0, integrator="rk4", output_dt=0.5)
+    b = simulate(base, x, 60.0, wind=10.0, integrator="semi-implicit", output_dt=0.5)
+    assert np.max(np.abs(a.cm_pos - b.cm_pos)) < 0.1
+    assert np.max(np.abs(a.euler - b.euler)) < 0.01
+
+
+def test_invalid_inputs_raise_clear_errors(base, trim0):
+    m = Model(base)
+    with pytest.raises(SimulationError, match="x0 contains non-finite"):
+        bad = trim0.x.copy()
+        bad[3] = np.nan
+        simulate(base, bad, 1.0)
+    with pytest.raises(SimulationError, match="shape"):
+        simulate(base, trim0.x[:-1], 1.0)
+    with pytest.raises(SimulationError, match="duration"):
+        simulate(base, trim0.x, -1.0)
+    with pytest.raises(SimulationError, match="unknown integrator"):
+        simulate(base, trim0.x, 1.0, integrator="euler")
+    with pytest.raises(SimulationError, match="winch input must be finite"):
+        simulate(base, trim0.x, 1.0, u=[np.inf, 0.0])
+    with pytest.raises(SimulationError, match="wind speed"):
+        Model(base, float("nan"))
+    with pytest.raises(ValueError, match="wind_speed"):
+        find_equilibrium(base, -3.0)
+    assert m.layout.size == 6 * 10 + 8
+
+
+def test_tether_break_is_reported(base, trim0):
+    """A tether weaker than the net lift breaks at once: reported as status 'break' with the
+    time and the tension, not an exception."""
+    weak = base.replace(**{"tether.strength": 1000.0})
+    tr = simulate(weak, trim0.x, 5.0, wind=0.0)
+    assert tr.status == "break"
+    assert tr.events[-1]["event"] == "break" and "exceeded" in tr.events[-1]["message"]
+
+
+def test_fully_slack_tether_is_reported(base, trim0):
+    """The aerostat thrown down at 5 m/s slackens every element: reported as a 'slack' event."""
+    m = Model(base, 0.0)
+    x = trim0.x.copy()
+    x[m.layout.cm_vel.start + 2] = -5.0
+    x[m.layout.node_vel] = np.tile([0.0, 0.0, -5.0], m.layout.n_nodes) * np.repeat(
+        np.linspace(0.9, 0.1, m.layout.n_nodes), 3)
+    tr = simulate(base, x, 3.0, wind=0.0, integrator="semi-implicit")
+    assert any(e["event"] == "slack" for e in tr.events)
+    assert tr.status in ("ok", "nonfinite", "break")
+
+
+def test_nonfinite_state_is_reported_not_raised(base, trim0):
+    """A non-finite state mid-run (forced by an absurd time step) ends the run with status
+    'nonfinite' and keeps only finite samples."""
+    strong = base.replace(**{"tether.strength": 1e300})  # so 'break' cannot fire first
+    tr = simulate(strong, trim0.x, 2.0, wind=10.0, integrator="rk4", dt=0.05)
+    assert tr.status == "nonfinite"
+    assert np.all(np.isfinite(tr.states))
+
+
+def test_trim_failure_is_an_error():
+    """No equilibrium (net lift 52 N cannot hold up the 70 N tether) is a clear TrimError that
+    names the wind speed, never a wrong answer."""
+    p = load_params(overrides={"aerostat.mass": 590.0})
+    with pytest.raises(TrimError, match="U = 0"):
+        find_equilibrium(p, 0.0)
