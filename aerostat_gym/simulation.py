@@ -133,7 +133,7 @@ class Model:
         """RK4 step from the axial stability bound at the given (default: configured) length."""
         d = self.params.derived
         L = self.params.tether.length if length is None else length
-        return rk4_step(d.EA, d.mass_per_length, L / self.n, self.params.simulation.rk4_safety)
+        return rk4_step(d.EA, d.mass_per_length, L / self.n, self.params.simulation.rk4_safety, self.n)
 
     # --- time stepping ---------------------------------------------------------------------
 

@@ -122,10 +122,9 @@ _ATAN_C = (0.999999999996503, -0.3333333310350973, 0.19999984562222467, -0.14285
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _atan01(r):
     z = r * r
-    acc = _ATAN_C[12]
-    for k in range(11, -1, -1):
-        acc = acc * z + _ATAN_C[k]
-    return r * acc
+    c = _ATAN_C
+    return r * (c[0] + z * (c[1] + z * (c[2] + z * (c[3] + z * (c[4] + z * (c[5] + z * (c[6] + z * (
+        c[7] + z * (c[8] + z * (c[9] + z * (c[10] + z * (c[11] + z * c[12]))))))))))))
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -163,7 +162,7 @@ def rotation_matrix(ph, th, ps):
     return out
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _kinematics(x, p, R, w):
     """Fill the work array with node positions and velocities (node 0 = confluence point from
     the aerostat state, node n = anchor) and the points where the wind is sampled: element
@@ -195,7 +194,7 @@ def _kinematics(x, p, R, w):
     return n + nf + 1
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def wind_batch(t, w, npts, base, wp, wf):
     """Air velocity at the npts points stored from ``w[base]``, written just after them.
 
@@ -220,7 +219,7 @@ def wind_batch(t, w, npts, base, wp, wf):
         w[out + 3 * i + 2] = az
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _tether(x, p, w):
     """Element tensions and node forces of the tether (inertial), from the kinematics and the
     winds already in the work array. Node 0's force acts on the aerostat. Returns the
@@ -301,7 +300,7 @@ def _tether(x, p, w):
     return w[T0 + n - 1]
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def tether_forces(t, x, p, wp, wf, R, w):
     """Kinematics, winds, tensions and node forces; returns the winch-end element tension."""
     npts = _kinematics(x, p, R, w)
