@@ -128,10 +128,14 @@ class WinchParams:
     max_acceleration: float = _f("m/s^2", "ESTIMATE", POSITIVE, "reel acceleration limit")
     speed_time_constant: float = _f("s", "ESTIMATE", POSITIVE, "closed speed-loop time constant")
     brake_speed: float = _f("m/s", "ESTIMATE", NONNEG, "set-points below this engage the brake")
+    brake_hold_speed: float = _f("m/s", "ESTIMATE", NONNEG,
+                                 "drum speed below which the brake clamps (v_w set to 0)")
     min_length: float = _f("m", "ESTIMATE", POSITIVE, "shortest tether length")
     max_length: float = _f("m", "ESTIMATE", POSITIVE, "longest tether length")
     safe_working_load: float = _f("N", "ESTIMATE", POSITIVE, "over-tension threshold")
     slack_tension: float = _f("N", "ESTIMATE", NONNEG, "slack threshold")
+    total_line_length: float = _f("m", "ESTIMATE", POSITIVE,
+                                  "line on the winch, paid out plus on the drum (>= max_length)")
 
 
 @dataclass(frozen=True)

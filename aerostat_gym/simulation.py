@@ -19,6 +19,7 @@ from .physics.core import rhs as _rhs
 from .physics.integrators import NONFINITE, rk4_advance, rk4_step, si_advance
 from .physics.layout import N_INPUTS, StateLayout, pack_params
 from .physics.wind import NO_FIELD, pack_wind, wind_from_params
+from .winch import WinchController
 
 INTEGRATORS = ("rk4", "semi-implicit")
 BRAKED = np.array([0.0, 1.0])
@@ -170,6 +171,16 @@ class Trajectory:
     reel_speed: np.ndarray
     status: str = "ok"
     events: list = field(default_factory=list)
+    # winch outputs (aerostat_gym.winch): per sample
+    load_cell: np.ndarray | None = None  # winch-end tension as measured [N]
+    mass_aloft: np.ndarray | None = None  # tether mass paid out [kg]
+    mass_on_drum: np.ndarray | None = None  # tether mass on the drum [kg]
+    # per control interval k, held over [time[k], time[k+1]) (length len(time) - 1)
+    v_set_requested: np.ndarray | None = None  # validated set-point [m/s]
+    v_set: np.ndarray | None = None  # set-point applied by the core [m/s] (clipped, 0 braking)
+    brake: np.ndarray | None = None  # brake holding the drum
+    clipped_count: int = 0  # intervals whose set-point was clipped to +-max_speed
+    thresholds: dict = field(default_factory=dict)  # event thresholds [N]
 
     @property
     def attitude(self) -> np.ndarray:
@@ -194,7 +205,15 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
     -------
     Trajectory. ``status`` is "ok", "break" (an element exceeded the tether strength; the run
     stops there), or "nonfinite" (numerical failure; the run stops at the last finite sample).
-    A fully slack tether is recorded in ``events`` and the run continues.
+    A fully slack tether is recorded in ``events`` ("slack") and the run continues, as are the
+    onsets of the winch events "winch_slack" (load cell below winch.slack_tension) and
+    "over_tension" (an element above winch.safe_working_load).
+
+    Notes
+    -----
+    The input passes once per output interval through :class:`aerostat_gym.winch.WinchController`
+    (set-point clipping and counting, the brake rule, which may set v_w to 0 as the brake
+    clamps), the same logic the environment uses per control step.
     """
     model = model or Model(params, wind)
     check_integrator(integrator)
@@ -209,18 +228,19 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
     if dt is not None and not (math.isfinite(dt) and dt > 0):
         raise SimulationError(f"dt must be finite and > 0, got {dt!r}")
     n_out = max(1, int(round(duration / output_dt)))
-    strength = model.params.tether.strength
+    winch = WinchController(model.params)
     times, states, tens, ends = [0.0], [x.copy()], [model.tensions(x)], [model.end_tensions(x)]
-    status, events = "ok", []
+    status, events, cmds = "ok", [], []
     for k in range(n_out):
         t = k * output_dt
-        uk = _input(u, t, x)
-        st, stats = model.advance(x, t, output_dt, uk, integrator, dt)
+        cmd = winch.command(_input(u, t, x), x)
+        st, stats = model.advance(x, t, output_dt, cmd.as_input(), integrator, dt)
         if st == NONFINITE:
             status = "nonfinite"
             events.append({"time": t + output_dt, "event": "nonfinite",
                            "message": "state became non-finite (numerical failure)"})
             break
+        cmds.append(cmd)
         times.append(t + output_dt)
         states.append(x.copy())
         tens.append(model.tensions(x, t + output_dt))
@@ -228,19 +248,25 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
         if stats[1] <= 0.0:
             events.append({"time": t + output_dt, "event": "slack",
                            "message": "every tether element was slack during this interval"})
-        if stats[0] > strength:
+        new = winch.detect_events(t + output_dt, winch.load_cell(ends[-1][1]), stats[0])
+        events.extend(new)
+        if any(e["event"] == "break" for e in new):
             status = "break"
-            events.append({"time": t + output_dt, "event": "break",
-                           "message": f"element tension {stats[0]:.0f} N exceeded the tether strength {strength:.0f} N"})
             break
     S = np.array(states)
     nodes = np.array([model.node_positions(s) for s in S])
     E = np.array(ends)
+    L = S[:, lay.winch_length]
     return Trajectory(
         time=np.array(times), states=S, cm_pos=S[:, lay.cm_pos], cm_vel=S[:, lay.cm_vel],
         euler=S[:, lay.euler], rates=S[:, lay.rates], node_pos=nodes, tensions=np.array(tens),
-        top_tension=E[:, 0], bottom_tension=E[:, 1], length=S[:, lay.winch_length],
+        top_tension=E[:, 0], bottom_tension=E[:, 1], length=L,
         reel_speed=S[:, lay.winch_speed], status=status, events=events,
+        load_cell=np.array([winch.load_cell(b) for b in E[:, 1]]),
+        mass_aloft=winch.mass_aloft(L), mass_on_drum=winch.mass_on_drum(L),
+        v_set_requested=np.array([c.requested for c in cmds]),
+        v_set=np.array([c.v_set for c in cmds]), brake=np.array([c.brake for c in cmds], dtype=bool),
+        clipped_count=sum(c.clipped for c in cmds), thresholds=winch.thresholds.as_dict(),
     )
 
 

@@ -498,19 +498,30 @@ def _air_body(ub, vb, wb, pp, qq, rr, cx, cy, cz, R, ax, ay, az):
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _winch(x, u, p, Tw, dx, o):
-    """Winch: L' = v_w; speed loop v_w' = clip((clip(v_set) - v_w)/tau, +-a_max) realised by a
-    motor force on the reflected drivetrain m_eq v_w' = T + F_m - F_c sgn(v_w) - c_v v_w with
-    |F_m| <= F_max. The brake (u[1] != 0) holds the drum: both derivatives zero."""
+    """Winch: L' = v_w; speed loop v_w' = clip((v_s - v_w)/tau, +-a_max) realised by a motor
+    force on the reflected drivetrain m_eq v_w' = T + F_m - F_c tanh(v_w/v_f) - c_v v_w with
+    |F_m| <= F_max, so the force limit (not the formula) decides when the loop loses authority.
+    The brake (u[1] != 0) holds the drum: both derivatives zero (the Python-side controller,
+    :mod:`aerostat_gym.winch`, brings v_w to zero before it engages the brake).
+
+    v_s is the set-point clipped to +-v_max and then capped near the length limits by the
+    stopping profile v_cap(d) = min(d / (4 tau), sqrt(a_max d)), d the distance to the limit.
+    The square-root part decelerates at a_max / 2, leaving the other half to the lag; the linear
+    part makes the closed loop critically damped at the limit (tau d'' + d' + d / (4 tau) = 0),
+    so the drum stops at the limit without overshoot when the motor has authority.
+    """
     L, v = x[o + 12], x[o + 13]
     if u[1] != 0.0:
         dx[o + 12] = 0.0
         dx[o + 13] = 0.0
         return
-    vmax = p[P_W_VMAX]
+    vmax, a_max, tau = p[P_W_VMAX], p[P_W_AMAX], p[P_W_TAU]
     vs = min(max(u[0], -vmax), vmax)
-    if (L <= p[P_W_LMIN] and vs < 0.0) or (L >= p[P_W_LMAX] and vs > 0.0):
-        vs = 0.0  # length limits: the drum stops paying in/out
-    a_des = min(max((vs - v) / p[P_W_TAU], -p[P_W_AMAX]), p[P_W_AMAX])
+    d_hi = max(p[P_W_LMAX] - L, 0.0)
+    d_lo = max(L - p[P_W_LMIN], 0.0)
+    vs = min(vs, min(d_hi / (4.0 * tau), math.sqrt(a_max * d_hi)))
+    vs = max(vs, -min(d_lo / (4.0 * tau), math.sqrt(a_max * d_lo)))
+    a_des = min(max((vs - v) / tau, -a_max), a_max)
     m_eq = p[P_W_MEQ]
     fr = p[P_W_FC] * math.tanh(v / p[P_W_FRICTION_V]) + p[P_W_CV] * v
     Fm = min(max(m_eq * a_des - Tw + fr, -p[P_W_FMAX]), p[P_W_FMAX])

@@ -1,0 +1,341 @@
+"""Ground winch: the logic that runs once per control step around the compiled speed loop.
+
+The continuous dynamics (speed loop with first-order lag, acceleration and speed limits, the
+drivetrain reflected to the line, the motor force limit, the length-limit stopping profile,
+the brake that freezes the drum) live in the compiled right-hand side
+(:func:`aerostat_gym.physics.core._winch`), whose input is ``u = [v_set, brake]``. This module
+holds what a winch's supervisory controller does between control steps, so that
+:func:`aerostat_gym.simulation.simulate` and the Gymnasium environment share one copy:
+
+- set-point validation: a NaN or infinite set-point is an error (:class:`WinchInputError`,
+  naming the value); a set-point beyond +-max_speed is clipped and counted;
+- the brake rule: the brake engages when commanded, or when |v_set| < ``brake_speed``; it
+  clamps the drum only once |v_w| <= ``brake_hold_speed`` (v_w is then set to exactly 0). Until
+  then the speed loop decelerates the drum toward zero at its acceleration limit;
+- the load cell (winch-end tether tension, noise-free for now);
+- tether mass bookkeeping: mass aloft mu L, mass on the drum mu (total_line_length - L);
+- events with their thresholds: ``winch_slack`` (load cell below ``slack_tension``),
+  ``over_tension`` (peak element tension above ``safe_working_load``), ``break`` (peak element
+  tension above the tether's ``strength``).
+
+Typical use, once per control step of length ``dt_c``::
+
+    winch = WinchController(params)
+    cmd = winch.command(action, x)           # may set x[v_w] = 0 as the brake clamps
+    status, stats = model.advance(x, t, dt_c, cmd.as_input())
+    load = winch.load_cell(model.end_tensions(x)[1])
+    events = winch.detect_events(t + dt_c, load, stats[0])
+
+The module also provides the reel-out/reel-in manoeuvre (:func:`reel_manoeuvre`) and the
+winch column of the input matrix B (:func:`winch_input_column`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .params import Params, load_params
+from .physics.layout import StateLayout
+
+
+class WinchInputError(ValueError):
+    """An invalid winch command (non-finite set-point or brake flag, wrong shape)."""
+
+
+@dataclass(frozen=True)
+class WinchThresholds:
+    """Tension thresholds of the winch events [N]."""
+
+    slack_tension: float
+    safe_working_load: float
+    strength: float
+
+    @classmethod
+    def from_params(cls, params: Params) -> WinchThresholds:
+        w = params.winch
+        return cls(w.slack_tension, w.safe_working_load, params.tether.strength)
+
+    def as_dict(self) -> dict:
+        return {"slack_tension": self.slack_tension, "safe_working_load": self.safe_working_load,
+                "strength": self.strength}
+
+
+@dataclass(frozen=True)
+class WinchCommand:
+    """What the winch applies over one control step.
+
+    requested : validated set-point [m/s] (before clipping). v_set : set-point sent to the
+    compiled core [m/s] (clipped to +-max_speed; 0 while braking). brake : the brake holds the
+    drum over this step. clipped : the requested set-point was beyond +-max_speed.
+    clamped : the brake engaged at the start of this step and set v_w to 0.
+    """
+
+    requested: float
+    v_set: float
+    brake: bool
+    clipped: bool
+    clamped: bool
+
+    def as_input(self) -> np.ndarray:
+        """The compiled core's input u = [v_set, brake]."""
+        return np.array([self.v_set, 1.0 if self.brake else 0.0])
+
+
+def parse_command(u) -> tuple[float, bool]:
+    """(set-point, brake flag) from a scalar set-point or a pair [v_set, brake].
+
+    Raises :class:`WinchInputError` naming the value for a non-finite entry or a wrong shape.
+    """
+    arr = np.asarray(u, dtype=float).reshape(-1)
+    if arr.size not in (1, 2):
+        raise WinchInputError(f"winch command must be v_set or [v_set, brake], got {u!r}")
+    v = float(arr[0])
+    if not math.isfinite(v):
+        raise WinchInputError(f"winch set-point must be finite, got v_set = {v!r}")
+    brake = float(arr[1]) if arr.size == 2 else 0.0
+    if not math.isfinite(brake):
+        raise WinchInputError(f"winch brake flag must be finite, got brake = {brake!r}")
+    return v, brake != 0.0
+
+
+class WinchController:
+    """Per-control-step winch logic (see the module docstring). One instance per episode.
+
+    Parameters
+    ----------
+    params : Params (default: the shipped baseline).
+
+    Attributes
+    ----------
+    n_steps, n_clipped : control steps taken and steps whose set-point was clipped.
+    braked : whether the brake holds the drum (after the last :meth:`command`).
+    thresholds : :class:`WinchThresholds`.
+    """
+
+    def __init__(self, params: Params | None = None):
+        self.params = params or load_params()
+        w = self.params.winch
+        if w.total_line_length < w.max_length:
+            raise ValueError(f"winch.total_line_length ({w.total_line_length} m) must be >= "
+                             f"winch.max_length ({w.max_length} m): the drum cannot pay out more line than it holds")
+        self.layout = StateLayout(self.params.tether.n_elements)
+        self.mu = self.params.derived.mass_per_length
+        self.thresholds = WinchThresholds.from_params(self.params)
+        self.reset()
+
+    def reset(self) -> None:
+        self.n_steps = 0
+        self.n_clipped = 0
+        self.braked = False
+        self._slack = False
+        self._over = False
+
+    # --- command -------------------------------------------------------------------------------
+
+    def command(self, u, x: np.ndarray) -> WinchCommand:
+        """Validate and apply one command ``u`` (v_set or [v_set, brake]) at state ``x``.
+
+        Brake rule: wanted when commanded or when |v_set| < brake_speed. If the drum is slow
+        enough (|v_w| <= brake_hold_speed) the brake clamps: ``x[v_w]`` is set to exactly 0 (in
+        place) and the core holds L fixed. Otherwise the speed loop decelerates the drum with
+        set-point 0 and the brake is tried again at the next step. Released, the set-point is
+        clipped to +-max_speed (counted in :attr:`n_clipped`).
+        """
+        w = self.params.winch
+        v, brake_cmd = parse_command(u)
+        clipped = abs(v) > w.max_speed and not brake_cmd  # a commanded brake ignores v_set
+        self.n_steps += 1
+        self.n_clipped += int(clipped)
+        v_clip = min(max(v, -w.max_speed), w.max_speed)
+        if brake_cmd or abs(v) < w.brake_speed:
+            iv = self.layout.winch_speed
+            if self.braked or abs(x[iv]) <= w.brake_hold_speed:
+                clamped = not self.braked
+                x[iv] = 0.0  # the brake holds the drum still: no residual reel speed
+                self.braked = True
+                return WinchCommand(v, 0.0, True, clipped, clamped)
+            self.braked = False
+            return WinchCommand(v, 0.0, False, clipped, False)  # decelerate first
+        self.braked = False
+        return WinchCommand(v, v_clip, False, clipped, False)
+
+    # --- measurements and bookkeeping ----------------------------------------------------------
+
+    def load_cell(self, bottom_tension: float) -> float:
+        """Load-cell reading [N]: the tether tension at the winch end (noise-free)."""
+        return float(bottom_tension)
+
+    @property
+    def total_mass(self) -> float:
+        """Tether mass on the winch, aloft plus on the drum [kg] (constant)."""
+        return self.mu * self.params.winch.total_line_length
+
+    def mass_aloft(self, length):
+        """Tether mass paid out [kg]: mu L (the lumped model carries exactly this mass)."""
+        return self.mu * np.asarray(length, dtype=float)
+
+    def mass_on_drum(self, length):
+        """Tether mass still on the drum [kg]: mu (total_line_length - L)."""
+        return self.mu * (self.params.winch.total_line_length - np.asarray(length, dtype=float))
+
+    # --- events --------------------------------------------------------------------------------
+
+    def detect_events(self, t: float, load_cell: float, peak_tension: float) -> list[dict]:
+        """Events at the end of a control step (onsets only for slack and over-tension).
+
+        load_cell : the winch-end tension at time t [N]. peak_tension : the largest element
+        tension over the step [N] (``stats[0]`` of :meth:`aerostat_gym.simulation.Model.advance`).
+        Returns a list of ``{"time", "event", "message", "value", "threshold"}`` dicts:
+        ``winch_slack`` (load cell falls below slack_tension), ``over_tension`` (peak rises above
+        safe_working_load), ``break`` (peak above the tether strength; every step it holds).
+        """
+        th, out = self.thresholds, []
+        slack = load_cell < th.slack_tension
+        if slack and not self._slack:
+            out.append(_event(t, "winch_slack", load_cell, th.slack_tension,
+                              f"winch tension {load_cell:.0f} N fell below the slack threshold "
+                              f"{th.slack_tension:.0f} N"))
+        self._slack = slack
+        over = peak_tension > th.safe_working_load
+        if over and not self._over:
+            out.append(_event(t, "over_tension", peak_tension, th.safe_working_load,
+                              f"element tension {peak_tension:.0f} N exceeded the safe working load "
+                              f"{th.safe_working_load:.0f} N"))
+        self._over = over
+        if peak_tension > th.strength:
+            out.append(_event(t, "break", peak_tension, th.strength,
+                              f"element tension {peak_tension:.0f} N exceeded the tether strength "
+                              f"{th.strength:.0f} N"))
+        return out
+
+
+def _event(t: float, name: str, value: float, threshold: float, message: str) -> dict:
+    return {"time": float(t), "event": name, "message": message, "value": float(value),
+            "threshold": float(threshold)}
+
+
+# --- motor force (diagnostic) --------------------------------------------------------------------
+
+
+def motor_force(model, x: np.ndarray, u: np.ndarray, t: float = 0.0) -> float:
+    """Motor force at the line [N] implied by the compiled core's drum acceleration:
+    F_m = m_eq v_w' - T_w + F_c tanh(v_w / v_f) + c_v v_w (NaN while braked)."""
+    if u[1] != 0.0:
+        return math.nan
+    from .physics.layout import P_W_FRICTION_V
+
+    w, lay = model.params.winch, model.layout
+    dx = model.rhs(x, u, t)
+    T0 = 9 * (model.n + 1)
+    Tw = model.work[T0 + model.n - 1]
+    v = x[lay.winch_speed]
+    fr = w.coulomb_friction * math.tanh(v / model.p[P_W_FRICTION_V]) + w.viscous_friction * v
+    return w.equivalent_mass * dx[lay.winch_speed] - Tw + fr
+
+
+# --- linearization: the winch column of B --------------------------------------------------------
+
+
+def winch_input_column(model, x: np.ndarray, eps: float = 1e-3, t: float = 0.0) -> np.ndarray:
+    """dF/dv_set at (x, u = [0, 0]) by central differences, brake released.
+
+    With the brake released and the set-point inside the limits the speed loop gives
+    v_w' = (v_set - v_w)/tau, so the column is 1/tau in the v_w row and zero elsewhere (the
+    coupling to the aerostat enters through A's L and v_w columns). ``eps`` must keep
+    eps/tau below max_acceleration so that the acceleration clip stays inactive.
+    """
+    up = model.rhs(x, np.array([eps, 0.0]), t)
+    um = model.rhs(x, np.array([-eps, 0.0]), t)
+    return (up - um) / (2.0 * eps)
+
+
+# --- reel-out / reel-in manoeuvre ----------------------------------------------------------------
+
+
+@dataclass
+class Manoeuvre:
+    """A reel-out/reel-in run: the trajectory, the trim it started from and its schedule."""
+
+    trajectory: object
+    equilibrium: object
+    target_length: np.ndarray = field(repr=False)
+    reel_in_time: float = 0.0
+
+
+def length_hold_law(target, speed: float, gain: float, length_index: int):
+    """u(t, x): set-point clip(gain (L_target(t) - L), +-speed), brake released; the winch's
+    brake rule engages the brake once |set-point| < brake_speed (near the target).
+    ``length_index`` is :attr:`StateLayout.winch_length`."""
+
+    def u(t, x):
+        L = x[length_index]
+        return [min(max(gain * (target(t) - L), -speed), speed), 0.0]
+
+    return u
+
+
+def reel_manoeuvre(params: Params | None = None, wind_speed: float = 10.0, distance: float = 50.0,
+                   speed: float | None = None, hold: float = 30.0, settle: float = 300.0,
+                   integrator: str = "rk4", dt: float | None = None, output_dt: float = 0.1,
+                   gain: float = 1.0) -> Manoeuvre:
+    """Reel out ``distance`` metres from the trim and back, in a steady wind.
+
+    From the trim at the configured tether length and ``wind_speed``, the length target is
+    L0 + distance until ``reel_in_time`` = distance / speed + hold, then L0; the set-point is
+    clip(gain (target - L), +-speed) (default speed: the winch's speed limit) and the brake
+    engages near each target. The run lasts reel_in_time + distance / speed + settle seconds.
+    """
+    from .analysis.trim import find_equilibrium
+    from .simulation import simulate
+
+    params = params or load_params()
+    speed = params.winch.max_speed if speed is None else float(speed)
+    if not (math.isfinite(speed) and speed > 0):
+        raise ValueError(f"speed must be finite and > 0, got {speed!r}")
+    eq = find_equilibrium(params, wind_speed)
+    iL = StateLayout(params.tether.n_elements).winch_length
+    L0 = float(eq.x[iL])
+    t_in = distance / speed + hold
+
+    def target(t):
+        return L0 + distance if t < t_in else L0
+
+    duration = t_in + distance / speed + settle
+    tr = simulate(params, eq.x, duration, wind=wind_speed, integrator=integrator, dt=dt,
+                  output_dt=output_dt, u=length_hold_law(target, speed, gain, iL))
+    targets = np.array([target(t) for t in tr.time])
+    return Manoeuvre(trajectory=tr, equilibrium=eq, target_length=targets, reel_in_time=t_in)
+
+
+def plot_manoeuvre(result: Manoeuvre, path) -> None:
+    """Length, reel speed, winch tension and aerostat altitude against time, into ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    tr = result.trajectory
+    fig, ax = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
+    ax[0].plot(tr.time, tr.length, label="L")
+    ax[0].plot(tr.time, result.target_length, "--", label="target")
+    ax[0].set_ylabel("length paid out [m]")
+    ax[0].legend(loc="best")
+    ax[1].plot(tr.time, tr.reel_speed, label="v_w")
+    ax[1].step(tr.time[:-1], tr.v_set, where="post", lw=0.8, label="set-point")
+    ax[1].set_ylabel("reel-out speed [m/s]")
+    ax[1].legend(loc="best")
+    ax[2].plot(tr.time, tr.load_cell, label="winch (load cell)")
+    ax[2].plot(tr.time, tr.top_tension, lw=0.8, label="aerostat end")
+    ax[2].set_ylabel("tension [N]")
+    ax[2].legend(loc="best")
+    ax[3].plot(tr.time, tr.cm_pos[:, 2])
+    ax[3].set_ylabel("aerostat altitude [m]")
+    ax[3].set_xlabel("time [s]")
+    U = result.equilibrium.wind_speed
+    fig.suptitle(f"Reel-out / reel-in at U = {U:g} m/s ({tr.status})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
