@@ -146,6 +146,10 @@ class WindParams:
     reference_height: float = _f("m", "ESTIMATE", POSITIVE, "reference height of power/log profiles")
     shear_exponent: float = _f("-", "ESTIMATE", NONNEG, "power-law exponent")
     roughness_length: float = _f("m", "ESTIMATE", POSITIVE, "log-law roughness length")
+    turbulence: str = _f("-", "ESTIMATE", ANY, "turbulence preset: none, light, moderate or severe")
+    turbulence_model: str = _f("-", "ESTIMATE", ANY, "turbulence spectrum: von_karman or dryden")
+    turbulence_reference_height: float = _f("m", "ESTIMATE", POSITIVE,
+                                            "height whose mean speed advects the frozen field and gusts")
 
 
 @dataclass(frozen=True)
@@ -188,6 +192,8 @@ SECTIONS = {
 }
 
 WIND_PROFILES = ("uniform", "power", "log")
+TURBULENCE_PRESETS = ("none", "light", "moderate", "severe")
+TURBULENCE_MODELS = ("von_karman", "dryden")
 
 # --- validation ----------------------------------------------------------------------------------
 
@@ -259,6 +265,11 @@ def _build_panels(panels: Any) -> tuple:
 
 def _cross_checks(p: Params) -> None:
     """Constraints between fields, checked after every load or override."""
+    if p.wind.turbulence not in TURBULENCE_PRESETS:
+        raise ParameterError(f"wind.turbulence must be one of {TURBULENCE_PRESETS}, got {p.wind.turbulence!r}")
+    if p.wind.turbulence_model not in TURBULENCE_MODELS:
+        raise ParameterError(
+            f"wind.turbulence_model must be one of {TURBULENCE_MODELS}, got {p.wind.turbulence_model!r}")
     if p.wind.profile not in WIND_PROFILES:
         raise ParameterError(f"wind.profile must be one of {WIND_PROFILES}, got {p.wind.profile!r}")
     if p.winch.min_length >= p.winch.max_length:

@@ -228,6 +228,10 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
     if dt is not None and not (math.isfinite(dt) and dt > 0):
         raise SimulationError(f"dt must be finite and > 0, got {dt!r}")
     n_out = max(1, int(round(duration / output_dt)))
+    if model.wf.shape[1] > 1:  # a turbulence field must cover the whole run (clear error if not)
+        from .wind.field import check_covers
+
+        check_covers(model.wp, model.wf, n_out * output_dt)
     winch = WinchController(model.params)
     times, states, tens, ends = [0.0], [x.copy()], [model.tensions(x)], [model.end_tensions(x)]
     status, events, cmds = "ok", [], []

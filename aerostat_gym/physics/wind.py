@@ -58,7 +58,12 @@ W_FIELD_DT = 18  # time step of the field [s]
 W_TAYLOR_U = 19  # advection speed U_a of the frozen field and of the gust [m/s]
 W_FIELD_XDOWN = 20  # the field covers points up to this far downwind of the anchor [m]
 W_FIELD_XUP = 21  # ... and up to this far upwind of the anchor [m]
-W_SIZE = 24
+# derived slots, kept in step by set_advection / set_field (multiplications are cheaper than
+# divisions in the sampler): 1/dz [1/m], 1/dt [1/s], 1/(U_a dt) [1/m]
+W_FIELD_IDZ = 22
+W_FIELD_IDT = 23
+W_TAYLOR_IDX = 24
+W_SIZE = 32
 
 PROFILES = {"uniform": 0, "power": 1, "log": 2}
 MIN_ADVECTION_SPEED = 0.5  # floor of U_a [m/s]: Taylor's hypothesis fails in calm air anyway
@@ -99,7 +104,25 @@ def set_advection(wp: np.ndarray, height: float, floor: float = MIN_ADVECTION_SP
     """Set the frozen-flow advection speed U_a = max(U(height), floor) in place; return it."""
     ua = max(float(mean_speed(float(height), wp)), floor)
     wp[W_TAYLOR_U] = ua
+    _update_derived(wp)
     return ua
+
+
+def _update_derived(wp: np.ndarray) -> None:
+    """Recompute the derived slots from dz, dt and U_a (left 0 while there is no field)."""
+    if wp[W_FIELD_DZ] > 0 and wp[W_FIELD_DT] > 0:
+        wp[W_FIELD_IDZ] = 1.0 / wp[W_FIELD_DZ]
+        wp[W_FIELD_IDT] = 1.0 / wp[W_FIELD_DT]
+        wp[W_TAYLOR_IDX] = wp[W_FIELD_IDT] / wp[W_TAYLOR_U]
+
+
+def derived_consistent(wp: np.ndarray) -> bool:
+    """True when the derived slots match dz, dt and U_a (always true without a field)."""
+    if wp[W_TURB_ON] == 0.0:
+        return True
+    want = np.array([1.0 / wp[W_FIELD_DZ], 1.0 / wp[W_FIELD_DT],
+                     1.0 / (wp[W_FIELD_DT] * wp[W_TAYLOR_U])])
+    return bool(np.allclose(wp[[W_FIELD_IDZ, W_FIELD_IDT, W_TAYLOR_IDX]], want, rtol=1e-12))
 
 
 def set_gust(wp: np.ndarray, amplitude: tuple[float, float, float], length: float,
@@ -142,6 +165,10 @@ def set_field(wp: np.ndarray, z0: float, dz: float, t0: float, dt: float,
     wp[W_FIELD_Z0], wp[W_FIELD_DZ] = z0, dz
     wp[W_FIELD_T0], wp[W_FIELD_DT] = t0, dt
     wp[W_FIELD_XDOWN], wp[W_FIELD_XUP] = x_down, x_up
+    if not (dz > 0 and dt > 0 and wp[W_TAYLOR_U] > 0):
+        raise ValueError(f"field steps and advection speed must be > 0, got dz={dz!r}, dt={dt!r}, "
+                         f"U_a={wp[W_TAYLOR_U]!r}")
+    _update_derived(wp)
 
 
 NO_FIELD = np.zeros((1, 0, 3))
@@ -170,8 +197,15 @@ def mean_speed(z, wp):
 
 @njit(**_JIT, inline="always")
 def _grid_index(f, n):
-    """Lower grid index and weight of fractional position f on a grid of n points (clamped)."""
-    f = min(max(f, 0.0), n - 1.0)
+    """Lower grid index and weight of fractional position f on a grid of n points (clamped).
+
+    Written so that a NaN position (a state gone non-finite) reads the first grid point rather
+    than stray memory: the sampler runs without bounds checks.
+    """
+    if f > 0.0:
+        f = min(f, n - 1.0)
+    else:
+        f = 0.0
     k = min(int(f), max(n - 2, 0))
     return k, f - k
 
@@ -184,8 +218,9 @@ def _field_sample(xa, z, t, wp, wf):
     row); :func:`aerostat_gym.wind.check_covers` verifies that an episode stays inside in time.
     """
     nz, nt = wf.shape[0], wf.shape[1]
-    kz, az = _grid_index((z - wp[W_FIELD_Z0]) / wp[W_FIELD_DZ], nz)
-    kt, at = _grid_index((t - xa / wp[W_TAYLOR_U] - wp[W_FIELD_T0]) / wp[W_FIELD_DT], nt)
+    kz, az = _grid_index((z - wp[W_FIELD_Z0]) * wp[W_FIELD_IDZ], nz)
+    # field time index of t - xa / U_a: ((t - t0) / dt) - xa / (U_a dt)
+    kt, at = _grid_index((t - wp[W_FIELD_T0]) * wp[W_FIELD_IDT] - xa * wp[W_TAYLOR_IDX], nt)
     kz1 = kz + 1 if nz > 1 else kz
     w00 = (1.0 - az) * (1.0 - at)
     w01 = (1.0 - az) * at
@@ -206,9 +241,9 @@ def _gust(xa, t, wp):
     return 0.0
 
 
-@njit(**_JIT)
-def air_velocity(x, y, z, t, wp, wf):
-    """Air velocity (inertial, m/s) at point (x, y, z) [m] and time t [s]."""
+@njit(**_JIT, inline="always")
+def _air_velocity(x, y, z, t, wp, wf):
+    """Body of :func:`air_velocity`, inlined into it and into :func:`air_velocity_batch`."""
     c, s = wp[W_DIRC], wp[W_DIRS]
     # along-wind coordinate of the point: sets the Taylor delay of the frozen field and gust
     xa = c * x + s * y
@@ -227,3 +262,26 @@ def air_velocity(x, y, z, t, wp, wf):
         wa += dw
     # rotate mean-wind axes (u along the heading, v to its left) to inertial X, Y
     return c * ua - s * va, s * ua + c * va, wa
+
+
+@njit(**_JIT)
+def air_velocity(x, y, z, t, wp, wf):
+    """Air velocity (inertial, m/s) at point (x, y, z) [m] and time t [s]."""
+    return _air_velocity(x, y, z, t, wp, wf)
+
+
+@njit(**_JIT)
+def air_velocity_batch(t, w, npts, base, wp, wf):
+    """Air velocity at npts points in one call (saves a function call per point).
+
+    Reads point i at ``w[base + 3 i : base + 3 i + 3]`` and writes its air velocity to
+    ``w[base + 3 npts + 3 i : ... + 3]`` (the layout of the core's work array); same values as
+    :func:`air_velocity`.
+    """
+    out = base + 3 * npts
+    for i in range(npts):
+        j = base + 3 * i
+        ax, ay, az = _air_velocity(w[j], w[j + 1], w[j + 2], t, wp, wf)
+        w[out + 3 * i] = ax
+        w[out + 3 * i + 1] = ay
+        w[out + 3 * i + 2] = az
