@@ -115,12 +115,11 @@ def _extra_benches():
         pass
     else:
         yield "moordyn_comparison", compare_with_moordyn
-    try:
-        from .wind.bench import bench_wind
-    except ImportError:
-        pass
-    else:
-        yield "wind", lambda quick: bench_wind()
+    from .analysis.bench_linear import bench_sweep
+    from .wind.bench import bench_wind
+
+    yield "wind", lambda quick: bench_wind()
+    yield "linear_sweep", lambda quick: bench_sweep()
 
 
 def format_text(res: dict, indent: int = 0) -> str:

@@ -1,8 +1,8 @@
 """Command-line interface: ``aerostat-gym <command> [options]``.
 
 Commands: ``trim`` (equilibrium summary), ``params`` (every parameter with its unit and status),
-``bench`` (speed and accuracy figures), ``wind`` (turbulence statistics, when the wind package
-is present). Errors in user input print one clear line and exit with status 2.
+``bench`` (speed and accuracy figures), ``wind`` (turbulence statistics), ``stability``,
+``table2`` and ``sensitivity`` (linear stability analysis). Errors in user input print one clear line and exit with status 2.
 """
 
 from __future__ import annotations
@@ -93,12 +93,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true")
     p.add_argument("--quick", action="store_true", help="shorter runs (smoke test)")
     p.set_defaults(func=cmd_bench)
-    try:
-        from .wind.cli import add_wind_parser
-    except ImportError:
-        pass
-    else:
-        add_wind_parser(sub)
+    from .analysis.stability_cli import add_stability_parsers
+    from .wind.cli import add_wind_parser
+
+    add_wind_parser(sub)
+    add_stability_parsers(sub)
     return ap
 
 

@@ -1,0 +1,347 @@
+"""Data and plots of [LN02] Figure 8 (linear versus nonlinear response) and Figure 9 (periods
+and damping ratios against wind speed), plus the tether-length and trim-pitch families.
+
+Data functions return plain dicts of lists (JSON-ready); ``plot_*`` functions import matplotlib
+lazily with the Agg backend, so the package never needs a display or matplotlib to import.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+from scipy.linalg import expm
+
+from ..params import Params, load_params
+from ..simulation import simulate
+from .linear import linearize
+from .modes import FIGURE9_MODES, SETS, Sweep, wind_sweep
+from .trim import find_equilibrium
+
+#: Figure 8 variables: aerostat CM position and Euler angles, with their units.
+FIG8_VARIABLES = (("x", "m"), ("y", "m"), ("z", "m"), ("phi", "rad"), ("theta", "rad"), ("psi", "rad"))
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+# --- Figure 8 ------------------------------------------------------------------------------------
+
+
+TETHER_NODES = ("trim", "relaxed")
+
+
+def figure8_initial_state(lin, translation: float = 0.1, rotation: float = 0.01,
+                          tether_nodes: str = "trim") -> np.ndarray:
+    """[LN02] Figure 8 initial condition about the trim ``lin.x_eq``: the aerostat CM moved by
+    +``translation`` m along inertial X, Y, Z and its Euler angles (phi, theta, psi) turned by
+    +``rotation`` rad; every velocity zero.
+
+    tether_nodes="trim" (default, the reading of "all six position variables for the aerostat
+    were simultaneously given an initial perturbation"): the tether nodes stay at their trim
+    positions, so the whole displacement of the confluence point stretches the top element
+    (for z = +0.1 m its tension more than doubles). "relaxed": the nodes take the static
+    positions of the linear model for the displaced aerostat, dn = -K_nn^-1 K_na da with K the
+    node-acceleration rows of A, so no element is suddenly stretched.
+    """
+    lay = lin.layout
+    x0 = lin.x_eq.copy()
+    x0[lay.cm_pos] += translation
+    x0[lay.euler] += rotation
+    if tether_nodes == "relaxed":
+        nodes = np.arange(lay.node_pos.start, lay.node_pos.stop)
+        acc = np.arange(lay.node_vel.start, lay.node_vel.stop)
+        body = np.r_[lay.cm_pos.start:lay.cm_pos.stop, lay.euler.start:lay.euler.stop]
+        da = (x0 - lin.x_eq)[body]
+        x0[nodes] -= np.linalg.solve(lin.A[np.ix_(acc, nodes)], lin.A[np.ix_(acc, body)] @ da)
+    elif tether_nodes != "trim":
+        raise ValueError(f"tether_nodes must be one of {TETHER_NODES}, got {tether_nodes!r}")
+    return x0
+
+
+def linear_response(A: np.ndarray, dx0: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """Free response dx(t) = expm(A t) dx0 at uniformly spaced ``times`` (rows).
+
+    Notes
+    -----
+    Exact for the LTI system: dx_{k+1} = Phi dx_k with Phi = expm(A dt).
+    """
+    dt = float(times[1] - times[0])
+    Phi = expm(A * dt)
+    out = np.empty((times.size, dx0.size))
+    out[0] = dx0
+    for k in range(1, times.size):
+        out[k] = Phi @ out[k - 1]
+    return out
+
+
+def nrms(linear: np.ndarray, nonlinear: np.ndarray) -> float:
+    """RMS(linear - nonlinear) / RMS(nonlinear), both as deviations from the trim."""
+    return float(np.sqrt(np.mean((linear - nonlinear) ** 2)) / np.sqrt(np.mean(nonlinear ** 2)))
+
+
+def _body_indices(lay) -> list[int]:
+    return list(range(lay.cm_pos.start, lay.cm_pos.stop)) + list(range(lay.euler.start, lay.euler.stop))
+
+
+def compare_responses(params: Params, lin, x0: np.ndarray, duration: float,
+                      output_dt: float) -> dict:
+    """Linear (exact, full 66-state braked A) and nonlinear (RK4) responses from x0."""
+    tr = simulate(params, x0, duration, wind=lin.wind_speed, output_dt=output_dt)
+    lay = lin.layout
+    dlin = linear_response(lin.A, (x0 - lin.x_eq)[lay.mechanical], tr.time)
+    out = {"time": tr.time.tolist(), "status": tr.status, "linear": {}, "nonlinear": {}, "nrms": {}}
+    for (name, _unit), i in zip(FIG8_VARIABLES, _body_indices(lay), strict=True):
+        nl = tr.states[:, i] - lin.x_eq[i]
+        out["linear"][name] = dlin[:, i].tolist()
+        out["nonlinear"][name] = nl.tolist()
+        out["nrms"][name] = nrms(dlin[:, i], nl)
+    return out
+
+
+def figure8_data(params: Params | None = None, wind_speed: float = 10.0, length: float = 300.0,
+                 duration: float = 80.0, output_dt: float = 0.1, scale: float = 1.0,
+                 tether_nodes: str = "trim") -> dict:
+    """Linear and nonlinear responses to the Figure 8 perturbation (L = 300 m, U = 10 m/s).
+
+    Parameters
+    ----------
+    scale : multiplies the [LN02] amplitudes (0.1 m, 0.01 rad). tether_nodes : see
+        :func:`figure8_initial_state`.
+
+    Returns
+    -------
+    dict: ``time``; per variable (x, y, z, phi, theta, psi) the deviations from trim
+    ``linear`` and ``nonlinear``; ``nrms`` per variable (RMS of the difference over the RMS of
+    the nonlinear response); the conditions.
+    """
+    p = (params or load_params()).replace(**{"tether.length": length})
+    lin = linearize(p, find_equilibrium(p, wind_speed))
+    x0 = figure8_initial_state(lin, 0.1 * scale, 0.01 * scale, tether_nodes)
+    out = compare_responses(p, lin, x0, duration, output_dt)
+    out.update(wind_speed_m_s=wind_speed, tether_length_m=length, scale=scale,
+               tether_nodes=tether_nodes)
+    return out
+
+
+def figure8_amplitude_scan(params: Params | None = None, scales=(1.0, 0.5, 0.3, 0.2, 0.1),
+                           tether_nodes=TETHER_NODES, wind_speed: float = 10.0,
+                           length: float = 300.0, duration: float = 80.0) -> list[dict]:
+    """nRMS per variable against the perturbation amplitude (fraction of [LN02]'s) for each
+    tether-node choice. A linearization error would not shrink with the amplitude; a nonlinear
+    effect shrinks in proportion (quadratic terms) or faster."""
+    p = (params or load_params()).replace(**{"tether.length": length})
+    lin = linearize(p, find_equilibrium(p, wind_speed))
+    rows = []
+    for nodes in tether_nodes:
+        for s in scales:
+            x0 = figure8_initial_state(lin, 0.1 * s, 0.01 * s, nodes)
+            res = compare_responses(p, lin, x0, duration, 0.1)
+            rows.append({"tether_nodes": nodes, "scale": s, **res["nrms"]})
+    return rows
+
+
+def plot_figure8(data: dict, path: str | Path) -> Path:
+    """Overlay of linear (dashed) and nonlinear (solid) responses, one panel per variable."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(3, 2, figsize=(10, 9), sharex=True)
+    t = np.array(data["time"])
+    for ax, (name, unit) in zip(axes.T.ravel(), FIG8_VARIABLES, strict=True):
+        ax.plot(t, data["nonlinear"][name], "k-", lw=1.2, label="non-linear")
+        ax.plot(t, data["linear"][name], "r--", lw=1.2, label="linear")
+        ax.set_ylabel(f"{name} ({unit})")
+        ax.set_title(f"nRMS diff {100 * data['nrms'][name]:.2f} %", fontsize=9)
+        ax.grid(alpha=0.3)
+    for ax in axes[-1]:
+        ax.set_xlabel("time (s)")
+    axes[0, 0].legend(loc="upper right", fontsize=8)
+    fig.suptitle(f"Linear vs non-linear response, L = {data['tether_length_m']:g} m, "
+                 f"U = {data['wind_speed_m_s']:g} m/s, {data['scale']:g} x (0.1 m, 0.01 rad), "
+                 f"tether nodes {data['tether_nodes']} (cf. [LN02] Fig. 8)", fontsize=10)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+# --- Figure 9 ------------------------------------------------------------------------------------
+
+
+def figure9_data(sweep: Sweep, modes: dict | None = None) -> dict:
+    """Periods and damping ratios of the Figure 9 modes along a wind sweep.
+
+    Period is 2 pi / omega_n; where a tracked mode is a real (non-oscillatory) eigenvalue, as
+    the neutral yaw mode at zero wind, period and damping are reported as null (the full modal
+    table, :meth:`Sweep.rows`, keeps them).
+    """
+    modes = modes or FIGURE9_MODES
+    out = {"wind_speed_m_s": sweep.values.tolist(), "all_stable": sweep.all_stable(),
+           "seconds": sweep.seconds}
+    for subset in SETS:
+        out[subset] = {}
+        for label in modes[subset]:
+            per = sweep.curve(subset, label, "period", oscillatory_only=True)
+            zeta = sweep.curve(subset, label, "zeta", oscillatory_only=True)
+            out[subset][label] = {"period_s": _nan_to_none(per), "zeta": _nan_to_none(zeta)}
+    return out
+
+
+def _nan_to_none(a: np.ndarray) -> list:
+    return [None if not math.isfinite(v) else float(v) for v in a]
+
+
+def write_table(rows: list[dict], path: str | Path) -> Path:
+    """CSV of flat rows (nested values JSON-encoded)."""
+    path = Path(path)
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    with path.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=keys)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: json.dumps(v) if isinstance(v, (dict, list)) else v for k, v in r.items()})
+    return path
+
+
+def figure9_rows(data: dict) -> list[dict]:
+    """Long-format rows (set, mode, U, period, zeta) of :func:`figure9_data`."""
+    rows = []
+    for subset in SETS:
+        for label, curves in data[subset].items():
+            for u, per, z in zip(data["wind_speed_m_s"], curves["period_s"], curves["zeta"], strict=True):
+                rows.append({"set": subset, "mode": label, "wind_speed_m_s": u, "period_s": per,
+                             "zeta": z})
+    return rows
+
+
+def plot_figure9(data: dict, path: str | Path, title: str = "") -> Path:
+    """[LN02] Figure 9 layout: longitudinal (left) and lateral (right) modes, period on top,
+    damping ratio below, against wind speed."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True)
+    u = np.array(data["wind_speed_m_s"], float)
+    styles = ["-", "--", "-.", ":", (0, (5, 1, 1, 1))]
+    colours = ["k", "tab:blue", "tab:red", "tab:green", "tab:purple"]
+    for col, (subset, name) in enumerate((("long", "Longitudinal"), ("lat", "Lateral"))):
+        for k, (label, curves) in enumerate(data[subset].items()):
+            per = np.array([np.nan if v is None else v for v in curves["period_s"]])
+            zeta = np.array([np.nan if v is None else v for v in curves["zeta"]])
+            kw = {"color": colours[k % 5], "ls": styles[k % 5], "label": label}
+            axes[0, col].plot(u, per, **kw)
+            axes[1, col].plot(u, zeta, **kw)
+        axes[0, col].set_title(f"{name} Modes")
+        axes[0, col].set_ylabel(r"period, $\tau_n$ (s)")
+        axes[1, col].set_ylabel(r"damping ratio, $\zeta$")
+        axes[1, col].set_xlabel("U (m/s)")
+        axes[0, col].set_ylim(0, 50 if subset == "long" else 100)
+        axes[1, col].set_ylim(0, 1)
+        axes[0, col].legend(fontsize=8)
+        for ax in axes[:, col]:
+            ax.grid(alpha=0.3)
+    fig.suptitle(title or "Longitudinal and lateral modes (cf. [LN02] Fig. 9)")
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def write_figure9(out_dir: str | Path, params: Params | None = None, speeds=None,
+                  sweep: Sweep | None = None) -> dict:
+    """Run (or take) the wind sweep; write figure9.png, figure9.csv, figure9.json and the full
+    modal table figure9_modes.csv (every tracked mode). Returns the Figure 9 data."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    sweep = sweep or wind_sweep(params, speeds)
+    data = figure9_data(sweep)
+    (out / "figure9.json").write_text(json.dumps(data, indent=1))
+    write_table(figure9_rows(data), out / "figure9.csv")
+    write_table(sweep.rows(), out / "figure9_modes.csv")
+    plot_figure9(data, out / "figure9.png")
+    return data
+
+
+def write_figure8(out_dir: str | Path, params: Params | None = None) -> dict:
+    """Run Figure 8; write figure8.png, figure8.json, figure8_nrms.csv, the same with relaxed
+    tether nodes (figure8_relaxed_tether.png) and figure8_amplitude_scan.csv. Returns the data
+    of the default case."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    data = figure8_data(params)
+    (out / "figure8.json").write_text(json.dumps(data))
+    write_table([{"variable": k, "nrms": v} for k, v in data["nrms"].items()], out / "figure8_nrms.csv")
+    plot_figure8(data, out / "figure8.png")
+    relaxed = figure8_data(params, tether_nodes="relaxed")
+    plot_figure8(relaxed, out / "figure8_relaxed_tether.png")
+    write_table(figure8_amplitude_scan(params), out / "figure8_amplitude_scan.csv")
+    return data
+
+
+# --- tether length and trim pitch families ------------------------------------------------------
+
+#: Families discussed by [LN02] ("changing various system parameters such as tether length and
+#: steady state pitch angle"): dotted parameter name -> values.
+FAMILIES = {
+    "tether.length": (150.0, 225.0, 300.0, 375.0),
+    "aerostat.trim_pitch_deg": (-8.0, -4.0, 0.0),
+}
+
+
+def family_data(params: Params | None, name: str, values, speeds=None) -> dict:
+    """Figure 9 data for each value of one parameter: {value: figure9_data}."""
+    base = params or load_params()
+    speeds = np.arange(0.0, 20.0 + 1e-9, 1.0) if speeds is None else speeds
+    return {float(v): figure9_data(wind_sweep(base.replace(**{name: v}), speeds)) for v in values}
+
+
+def plot_family(fam: dict, name: str, path: str | Path) -> Path:
+    """One colour per parameter value; one line style per mode; Figure 9 layout."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True)
+    styles = ["-", "--", "-.", ":", (0, (5, 1, 1, 1))]
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for j, (value, data) in enumerate(fam.items()):
+        u = np.array(data["wind_speed_m_s"], float)
+        for col, subset in enumerate(SETS):
+            for k, (label, curves) in enumerate(data[subset].items()):
+                per = np.array([np.nan if v is None else v for v in curves["period_s"]])
+                zeta = np.array([np.nan if v is None else v for v in curves["zeta"]])
+                kw = {"color": colours[j % len(colours)], "ls": styles[k % 5], "lw": 1.1}
+                axes[0, col].plot(u, per, label=f"{label}, {value:g}" if j == 0 or k == 0 else None, **kw)
+                axes[1, col].plot(u, zeta, **kw)
+    for col, title in enumerate(("Longitudinal", "Lateral")):
+        axes[0, col].set_title(f"{title} modes, {name} = " + ", ".join(f"{v:g}" for v in fam))
+        axes[0, col].set_ylabel(r"period, $\tau_n$ (s)")
+        axes[1, col].set_ylabel(r"damping ratio, $\zeta$")
+        axes[1, col].set_xlabel("U (m/s)")
+        axes[0, col].set_yscale("log")
+        axes[1, col].set_ylim(0, 1)
+        axes[0, col].legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def write_families(out_dir: str | Path, params: Params | None = None, speeds=None) -> dict:
+    """Tether-length and trim-pitch families: PNG and JSON per parameter."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    result = {}
+    for name, values in FAMILIES.items():
+        fam = family_data(params, name, values, speeds)
+        stem = "family_" + name.replace(".", "_")
+        (out / f"{stem}.json").write_text(json.dumps({str(k): v for k, v in fam.items()}, indent=1))
+        plot_family(fam, name, out / f"{stem}.png")
+        result[name] = fam
+    return result

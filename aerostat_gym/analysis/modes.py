@@ -1,0 +1,468 @@
+"""Modal analysis of the decoupled linear model: modal tables, mode classification, MAC tracking,
+and sweeps over wind speed (Figure 9 of [LN02]), tether length and trim pitch.
+
+Each eigenvalue lambda of A_long or A_lat (one per complex-conjugate pair, or a real one) is a
+:class:`Mode` with python-control's ``damp`` quantities (natural frequency, damping ratio) and its
+eigenvector. The eigenvector's position part (x, z, theta or y, phi, psi) is weighted by the
+inertia that goes with each coordinate, which turns |v_i|^2 into each coordinate's share of the
+modal kinetic energy. Classification reads those shares and the shape of the tether (sign
+changes along the nodes), as [LN02] classified its modes by eye.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from ..params import Params, load_params
+from ..physics.core import rotation_matrix
+from ..physics.layout import StateLayout
+from .linear import Decoupled, LinearModel, decouple, linearize
+from .trim import Equilibrium, find_equilibrium
+
+SETS = ("long", "lat")
+#: |lambda| below this [rad/s] (a period above about 17 h) counts as a neutral rigid-body mode:
+#: at zero wind the whole system may turn about the vertical through the anchor, a double zero
+#: eigenvalue that finite differences split into +-sqrt(rounding), a few 1e-5.
+NEUTRAL_RATE = 1e-4
+#: The modes of [LN02] Figure 9, per set, plus the yaw mode, which in this model is among the
+#: four lowest lateral modes (the paper's yaw is merged into its lateral pendulum).
+FIGURE9_MODES = {
+    "long": ("pendulum", "pitching", "axial spring", "tether 1st harmonic"),
+    "lat": ("pendulum", "rolling", "tether 1st harmonic", "tether 2nd harmonic", "yaw"),
+}
+
+
+def ordinal(k: int) -> str:
+    suffix = {1: "st", 2: "nd", 3: "rd"}.get(k if k < 20 else k % 10, "th")
+    return f"{k}{suffix}"
+
+
+@dataclass
+class Mode:
+    """One mode of a subset.
+
+    Attributes
+    ----------
+    eigenvalue : lambda (Im >= 0 for a complex pair). vector : eigenvector in the subset's state
+    order. wn : natural frequency |lambda| [rad/s]. zeta : -Re(lambda)/|lambda|. period : 2 pi / wn
+    [s]. oscillatory : Im(lambda) != 0. stable : Re(lambda) < 0 or neutral. neutral : |lambda| <
+    :data:`NEUTRAL_RATE`. label : classification. energy : kinetic-energy share per state group.
+    shape : real-ified transverse tether shape, anchor (0) to confluence point.
+    sign_changes : sign changes of the shape along the moving nodes.
+    """
+
+    eigenvalue: complex
+    vector: np.ndarray
+    wn: float
+    zeta: float
+    period: float
+    oscillatory: bool
+    stable: bool
+    neutral: bool
+    label: str = ""
+    energy: dict = field(default_factory=dict)
+    shape: np.ndarray | None = None
+    sign_changes: int = 0
+
+    def row(self) -> dict:
+        """Plain-number summary (for tables and JSON)."""
+        return {"label": self.label, "eigenvalue_re": float(self.eigenvalue.real),
+                "eigenvalue_im": float(self.eigenvalue.imag), "wn_rad_s": self.wn,
+                "zeta": self.zeta, "period_s": self.period if math.isfinite(self.period) else None,
+                "oscillatory": self.oscillatory,
+                "stable": self.stable, "neutral": self.neutral,
+                "energy": {k: round(v, 4) for k, v in self.energy.items()}}
+
+
+# --- classification context ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ModeContext:
+    """What classification needs to know about one subset's state vector.
+
+    Attributes
+    ----------
+    subset : "long" or "lat". pos : indices of the position coordinates within the subset
+    vector. weights : inertia of each position coordinate (kg or kg m^2). groups : group name ->
+    indices into ``pos``. tether : indices into ``pos`` of the moving nodes' transverse
+    coordinate, top (node 2) to bottom (node n). top : confluence-point transverse displacement
+    as a linear map of the position part. transverse, axial : tether group names.
+    """
+
+    subset: str
+    pos: np.ndarray
+    weights: np.ndarray
+    groups: dict
+    tether: np.ndarray
+    top: np.ndarray
+    transverse: str
+    axial: str | None
+
+
+def _leash_jacobian(x_eq: np.ndarray, layout: StateLayout, leash: tuple) -> np.ndarray:
+    """d(R(phi, theta, psi) r_l)/d(phi, theta, psi), 3x3: how attitude moves the confluence
+    point relative to the CM (central differences of the rotation matrix, step 1e-6 rad)."""
+    e0 = x_eq[layout.euler]
+    J = np.empty((3, 3))
+    for k in range(3):
+        d = np.zeros(3)
+        d[k] = 1e-6
+        J[:, k] = (rotation_matrix(*(e0 + d)) - rotation_matrix(*(e0 - d))) @ np.array(leash) / 2e-6
+    return J
+
+
+def mode_context(params: Params, x_eq: np.ndarray, subset: str) -> ModeContext:
+    """Build the :class:`ModeContext` of ``subset`` ("long" or "lat") at the trim ``x_eq``.
+
+    Notes
+    -----
+    Kinetic-energy weights: tether node mu l_u per direction; aerostat CM m_e,x for inertial X
+    (the hull axis is along X within the trim pitch), m_e,y for Y, m_e,z for Z; I_yy for theta,
+    I_xx for phi, I_zz for psi.
+    """
+    lay = StateLayout(params.tether.n_elements)
+    n, d, a = lay.n_elements, params.derived, params.aerostat
+    m_node = d.mass_per_length * x_eq[lay.winch_length] / n
+    J = _leash_jacobian(x_eq, lay, d.leash_position)
+    tnodes = np.arange(n - 1)
+    if subset == "long":
+        # subset order: x (n), xdot (n), z (n), zdot (n), theta, q; aerostat CM last in each block
+        pos = np.concatenate([np.arange(n), 2 * n + np.arange(n), [4 * n]])
+        w = np.concatenate([np.full(n - 1, m_node), [d.effective_mass[0]],
+                            np.full(n - 1, m_node), [d.effective_mass[2]], [a.Iyy]])
+        groups = {"tether_x": tnodes, "aerostat_x": np.array([n - 1]),
+                  "tether_z": n + tnodes, "aerostat_z": np.array([2 * n - 1]),
+                  "pitch": np.array([2 * n])}
+        top = np.zeros(pos.size)
+        top[n - 1], top[2 * n] = 1.0, J[0, 1]
+        return ModeContext("long", pos, w, groups, tnodes, top, "tether_x", "tether_z")
+    if subset == "lat":
+        # subset order: y (n), ydot (n), phi, p, psi, r
+        pos = np.concatenate([np.arange(n), [2 * n, 2 * n + 2]])
+        w = np.concatenate([np.full(n - 1, m_node), [d.effective_mass[1]], [a.Ixx, a.Izz]])
+        groups = {"tether_y": tnodes, "aerostat_y": np.array([n - 1]),
+                  "roll": np.array([n]), "yaw": np.array([n + 1])}
+        top = np.zeros(pos.size)
+        top[n - 1], top[n], top[n + 1] = 1.0, J[1, 0], J[1, 2]
+        return ModeContext("lat", pos, w, groups, tnodes, top, "tether_y", None)
+    raise ValueError(f"subset must be 'long' or 'lat', got {subset!r}")
+
+
+def energy_vector(vector: np.ndarray, ctx: ModeContext) -> np.ndarray:
+    """sqrt(m_i) v_i over the position coordinates: |.|^2 is each coordinate's share of the
+    modal kinetic energy (up to the common factor |lambda|^2 / 2)."""
+    return np.sqrt(ctx.weights) * vector[ctx.pos]
+
+
+def _realify(v: np.ndarray) -> np.ndarray:
+    """Rotate a complex vector by the phase that makes it as real as possible, return Re.
+
+    Notes
+    -----
+    alpha = arg(sum v_k^2) / 2 maximises ||Re(v e^{-i alpha})||; for a standing-wave mode all
+    components then share one phase and the sign pattern is the mode shape.
+    """
+    alpha = 0.5 * np.angle(np.sum(v * v))
+    return np.real(v * np.exp(-1j * alpha))
+
+
+def count_sign_changes(shape: np.ndarray, threshold: float = 0.1) -> int:
+    """Sign changes along ``shape``, ignoring entries below ``threshold`` of its largest |entry|."""
+    big = shape[np.abs(shape) > threshold * np.max(np.abs(shape))]
+    return int(np.sum(np.signbit(big[1:]) != np.signbit(big[:-1])))
+
+
+def classify(vector: np.ndarray, ctx: ModeContext) -> tuple[str, dict, np.ndarray, int]:
+    """Name a mode from its eigenvector.
+
+    Returns
+    -------
+    label, energy shares per group, transverse tether shape (anchor, node n .. node 2,
+    confluence point), sign changes along the moving nodes.
+
+    Notes
+    -----
+    Rules (after [LN02]'s descriptions of its eigenvectors):
+
+    * tether nodes hold most of the kinetic energy -> a tether mode; the k-th harmonic has k - 1
+      sign changes along the nodes ("tether axial k" if the longitudinal motion is mostly z);
+    * otherwise the aerostat's largest share names it: longitudinal x -> pendulum, z -> axial
+      spring, theta -> pitching; lateral y -> pendulum, phi -> rolling, psi -> yaw.
+    """
+    v = vector[ctx.pos]
+    e = ctx.weights * np.abs(v) ** 2
+    total = float(np.sum(e)) or 1.0
+    energy = {g: float(np.sum(e[idx])) / total for g, idx in ctx.groups.items()}
+    real = _realify(v)
+    shape = np.concatenate([[0.0], real[ctx.tether][::-1], [real @ ctx.top]])
+    tether_share = energy[ctx.transverse] + (energy[ctx.axial] if ctx.axial else 0.0)
+    if tether_share > 0.5:
+        axial = ctx.axial is not None and energy[ctx.axial] > energy[ctx.transverse]
+        coord = ctx.groups[ctx.axial] if axial else ctx.tether
+        k = count_sign_changes(real[coord]) + 1
+        label = f"tether axial {k}" if axial else f"tether {ordinal(k)} harmonic"
+        return label, energy, shape, k - 1
+    names = ({"aerostat_x": "pendulum", "aerostat_z": "axial spring", "pitch": "pitching"}
+             if ctx.subset == "long" else
+             {"aerostat_y": "pendulum", "roll": "rolling", "yaw": "yaw"})
+    label = names[max(names, key=lambda g: energy[g])]
+    return label, energy, shape, count_sign_changes(real[ctx.tether])
+
+
+# --- modal tables --------------------------------------------------------------------------------
+
+
+def damp_quantities(lam: complex) -> tuple[float, float, float]:
+    """(wn, zeta, period) of one eigenvalue, as ``control.damp``.
+
+    Notes
+    -----
+    omega_n = |lambda|, zeta = -Re(lambda) / omega_n, tau_n = 2 pi / omega_n ([LN02]:
+    omega_n = sqrt(sigma^2 + omega_d^2), zeta = sin(atan(-sigma / omega_d))).
+    """
+    wn = float(abs(lam))
+    if wn == 0.0:
+        return 0.0, 1.0, math.inf
+    return wn, float(-lam.real / wn), 2.0 * math.pi / wn
+
+
+def modal_table(A_sub: np.ndarray, ctx: ModeContext) -> list[Mode]:
+    """Eigen-decompose one subset and classify its modes; sorted by natural frequency.
+
+    One :class:`Mode` per complex-conjugate pair (the member with Im > 0) and per real
+    eigenvalue, so an n-state subset has n / 2 modes when all are oscillatory; [LN02] counts
+    3 n + 3 modes for the 6 n + 6 states, real eigenvalues counted in pairs.
+    """
+    lam, V = np.linalg.eig(A_sub)
+    scale = max(float(np.max(np.abs(lam))), 1.0)
+    modes = []
+    for k in np.argsort(np.abs(lam), kind="stable"):
+        ev = complex(lam[k])
+        if ev.imag < -1e-12 * scale:
+            continue  # the conjugate partner carries the same mode
+        ev = complex(ev.real, max(ev.imag, 0.0)) if abs(ev.imag) <= 1e-12 * scale else ev
+        wn, zeta, period = damp_quantities(ev)
+        neutral = wn < NEUTRAL_RATE
+        label, energy, shape, sc = classify(V[:, k], ctx)
+        modes.append(Mode(ev, V[:, k].copy(), wn, zeta, period, ev.imag > 0,
+                          ev.real < 0 or neutral, neutral, label, energy, shape, sc))
+    resolve_duplicates(modes, ctx.subset)
+    return modes
+
+
+#: The aerostat's own modes in each set and the energy group that names each.
+AEROSTAT_MODES = {
+    "long": {"pendulum": "aerostat_x", "axial spring": "aerostat_z", "pitching": "pitch"},
+    "lat": {"pendulum": "aerostat_y", "rolling": "roll", "yaw": "yaw"},
+}
+
+
+def resolve_duplicates(modes: list[Mode], subset: str) -> None:
+    """Give each missing aerostat mode to the duplicate-labelled mode that carries most of it.
+
+    Notes
+    -----
+    Each of the aerostat's modes exists once per set. When coupling hides one (in wind the
+    lateral yaw mode sways the aerostat with the tether, so its largest energy share is y like
+    the pendulum's; at zero wind rolling and the first lateral tether harmonic share energy
+    about equally), two modes get the same label and one label is missing. The mode with the
+    largest energy share in the missing mode's group, among those with a repeated label,
+    takes the missing label (in place).
+    """
+    for label, group in AEROSTAT_MODES[subset].items():
+        labels = [m.label for m in modes]
+        if label in labels:
+            continue
+        dup = [m for m in modes if labels.count(m.label) > 1 and m.energy[group] > 0.05]
+        if dup:
+            max(dup, key=lambda m: m.energy[group]).label = label
+
+
+def count_modes(modes: list[Mode]) -> float:
+    """Modes counted as in [LN02]: a complex pair is one mode, two real eigenvalues are one."""
+    return sum(1.0 if m.oscillatory else 0.5 for m in modes)
+
+
+@dataclass
+class ModalAnalysis:
+    """Linearization, decoupling and both modal tables at one trim."""
+
+    wind_speed: float
+    linear: LinearModel
+    decoupled: Decoupled
+    long: list[Mode]
+    lat: list[Mode]
+
+    def all_stable(self) -> bool:
+        return all(m.stable for m in self.long + self.lat)
+
+    def find(self, subset: str, label: str) -> Mode | None:
+        """Lowest-frequency mode of ``subset`` with this label."""
+        return next((m for m in getattr(self, subset) if m.label == label), None)
+
+
+def analyse(params: Params, equilibrium: Equilibrium, eps: float = 1e-5) -> ModalAnalysis:
+    """Linearize about ``equilibrium``, decouple, and build both modal tables."""
+    lin = linearize(params, equilibrium, eps)
+    dec = decouple(lin.A, lin.layout)
+    long = modal_table(dec.A_long, mode_context(params, equilibrium.x, "long"))
+    lat = modal_table(dec.A_lat, mode_context(params, equilibrium.x, "lat"))
+    return ModalAnalysis(equilibrium.wind_speed, lin, dec, long, lat)
+
+
+# --- MAC tracking --------------------------------------------------------------------------------
+
+
+def mac(a: np.ndarray, b: np.ndarray) -> float:
+    """Modal assurance criterion |a^H b|^2 / ((a^H a)(b^H b)), in [0, 1]."""
+    return float(abs(np.vdot(a, b)) ** 2 / (np.vdot(a, a).real * np.vdot(b, b).real))
+
+
+def track(tables: list[list[Mode]], ctx_list: list[ModeContext], freq_weight: float = 0.5,
+          min_mac: float = 0.2) -> list[list[Mode | None]]:
+    """Follow modes across a sweep by eigenvector similarity.
+
+    Parameters
+    ----------
+    tables : modal table at each sweep point. ctx_list : the matching contexts.
+    freq_weight : weight of the frequency jump in the matching cost. min_mac : a match needs at
+        least this MAC; otherwise the mode starts a new track.
+
+    Returns
+    -------
+    tracks : each a list with one :class:`Mode` (or None) per sweep point.
+
+    Notes
+    -----
+    Each step solves an assignment problem (Hungarian method) between the last mode of every
+    track and the current modes with cost 1 - MAC(phi_a, phi_b) + w |ln(omega_a / omega_b)|,
+    MAC taken on the energy-weighted position vectors sqrt(m) v.
+    """
+    tracks: list[list[Mode | None]] = [[m] for m in tables[0]]
+    vecs = [energy_vector(m.vector, ctx_list[0]) for m in tables[0]]
+    for step in range(1, len(tables)):
+        cur = tables[step]
+        cv = [energy_vector(m.vector, ctx_list[step]) for m in cur]
+        last = [next(m for m in reversed(t) if m is not None) for t in tracks]
+        cost = np.array([[1.0 - mac(vecs[i], cv[j])
+                          + freq_weight * abs(math.log(max(cur[j].wn, 1e-9) / max(last[i].wn, 1e-9)))
+                          for j in range(len(cur))] for i in range(len(tracks))])
+        rows, cols = linear_sum_assignment(cost)
+        taken = set()
+        for i, j in zip(rows, cols, strict=True):
+            if mac(vecs[i], cv[j]) >= min_mac:
+                tracks[i].append(cur[j])
+                vecs[i] = cv[j]
+                taken.add(j)
+        for t in tracks:
+            if len(t) < step + 1:
+                t.append(None)
+        for j, m in enumerate(cur):
+            if j not in taken:
+                tracks.append([None] * step + [m])
+                vecs.append(cv[j])
+    return tracks
+
+
+def track_label(track_modes: list[Mode | None]) -> str:
+    """The most frequent classification along a track (ties: the earliest)."""
+    labels = [m.label for m in track_modes if m is not None]
+    return max(dict.fromkeys(labels), key=labels.count)
+
+
+# --- sweeps --------------------------------------------------------------------------------------
+
+
+@dataclass
+class Sweep:
+    """Modal analyses along a parameter (wind speed by default), with tracked modes.
+
+    Attributes
+    ----------
+    values : swept values. variable : its name. analyses : one :class:`ModalAnalysis` per value.
+    tracks : per set, list of (label, [Mode or None per value]). seconds : wall time.
+    """
+
+    values: np.ndarray
+    variable: str
+    analyses: list
+    tracks: dict
+    seconds: float
+
+    def curve(self, subset: str, label: str, quantity: str = "period",
+              oscillatory_only: bool = False) -> np.ndarray:
+        """``period``, ``zeta`` or ``wn`` of the tracked mode ``label`` at every value (nan where
+        absent, or where the mode is a real eigenvalue and ``oscillatory_only``)."""
+        t = next((m for lab, m in self.tracks[subset] if lab == label), None)
+        if t is None:
+            return np.full(len(self.values), np.nan)
+        keep = [m is not None and (m.oscillatory or not oscillatory_only) for m in t]
+        return np.array([getattr(m, quantity) if k else np.nan for m, k in zip(t, keep, strict=True)])
+
+    def all_stable(self) -> bool:
+        return all(a.all_stable() for a in self.analyses)
+
+    def rows(self) -> list[dict]:
+        """One row per (value, set, tracked mode): label, period, damping, stability."""
+        out = []
+        for subset in SETS:
+            for label, t in self.tracks[subset]:
+                for v, m in zip(self.values, t, strict=True):
+                    if m is not None:
+                        out.append({self.variable: float(v), "set": subset, **m.row(),
+                                    "label": label})
+        return out
+
+
+def _label_tracks(tracks: list[list[Mode | None]]) -> list[tuple[str, list]]:
+    """Label every track; a repeated label gets a suffix (2), (3) in order of frequency."""
+    def mean_wn(t):
+        return float(np.mean([m.wn for m in t if m is not None]))
+
+    def present(t):
+        return sum(m is not None for m in t)
+
+    out, seen = [], {}
+    # the longest track keeps the plain label; shorter namesakes get (2), (3)
+    for t in sorted(tracks, key=lambda t: (-present(t), mean_wn(t))):
+        lab = track_label(t)
+        seen[lab] = seen.get(lab, 0) + 1
+        out.append((lab if seen[lab] == 1 else f"{lab} ({seen[lab]})", t))
+    return sorted(out, key=lambda item: mean_wn(item[1]))
+
+
+def sweep_analyses(analyses: list[ModalAnalysis], params_list: list[Params], values,
+                   variable: str, seconds: float) -> Sweep:
+    """Track the modes of a list of analyses (one per swept value) into a :class:`Sweep`."""
+    tracks = {}
+    for subset in SETS:
+        ctxs = [mode_context(p, a.linear.x_eq, subset) for p, a in zip(params_list, analyses, strict=True)]
+        tables = [getattr(a, subset) for a in analyses]
+        tracks[subset] = _label_tracks(track(tables, ctxs))
+    return Sweep(np.asarray(values, float), variable, analyses, tracks, seconds)
+
+
+def wind_sweep(params: Params | None = None, speeds=None, eps: float = 1e-5) -> Sweep:
+    """Trim, linearize and analyse at every wind speed (continuation from the previous trim).
+
+    Parameters
+    ----------
+    params : parameters (default baseline). speeds : wind speeds [m/s] (default 0:20:0.5, the
+    41 speeds of [LN02] Figure 9), increasing. eps : finite-difference step.
+    """
+    params = params or load_params()
+    speeds = np.arange(0.0, 20.0 + 1e-9, 0.5) if speeds is None else np.asarray(speeds, float)
+    t0 = time.perf_counter()
+    analyses, eq = [], None
+    for u in speeds:
+        eq = find_equilibrium(params, float(u), guess=eq)
+        analyses.append(analyse(params, eq, eps))
+    return sweep_analyses(analyses, [params] * len(speeds), speeds, "wind_speed_m_s",
+                          time.perf_counter() - t0)
+

@@ -1,0 +1,288 @@
+"""Sensitivity of the linear results to the estimated and calibrated parameters.
+
+Most aerostat parameters of the baseline are ESTIMATE or CALIB (``parameter_table()``); this
+module moves each across its stated plausible range (docs/parameters.md; the range and its
+source are in :data:`KNOBS`) and reports how the four [LN02] Table 2 periods at U = 1 m/s and
+the smallest damping ratio of the Figure 9 modes over 1..20 m/s respond. It tells a user which
+of their own aerostat's numbers matter, and :func:`solve_for_period` says how far one knob must
+move to put a period on a target (for a documented calibration, never applied silently).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..params import Params, load_params, params_to_dict
+from .modes import FIGURE9_MODES, SETS, analyse
+from .reference import TABLE2, linear_table2_periods
+from .trim import TrimError, find_equilibrium
+
+#: Wind speeds of the damping search [m/s] (U = 0 is left out: without wind only the tether's
+#: material damping acts and every aerostat mode is undamped whatever the parameters).
+DAMPING_SPEEDS = (1.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 18.0, 20.0)
+PERIOD_KEYS = tuple(TABLE2)
+
+
+@dataclass(frozen=True)
+class Knob:
+    """One uncertain parameter with its plausible range.
+
+    Attributes
+    ----------
+    key : identifier (a dotted parameter name, or a derived knob such as ``cm_x_shift``).
+    label : text for tables. status : ESTIMATE or CALIB. unit : unit of the knob's value.
+    low, high : ends of the plausible range. source : where the range comes from.
+    get : value of the knob in a parameter set. put : parameter set with the knob at a value.
+    """
+
+    key: str
+    label: str
+    status: str
+    unit: str
+    low: float
+    high: float
+    source: str
+    get: Callable[[Params], float]
+    put: Callable[[Params, float], Params]
+
+
+def _dotted(key: str) -> tuple[Callable, Callable]:
+    sec, name = key.split(".")
+    return (lambda p: float(getattr(getattr(p, sec), name)),
+            lambda p, v: p.replace(**{key: float(v)}))
+
+
+def _vector_component(key: str, k: int) -> tuple[Callable, Callable]:
+    sec, name = key.split(".")
+
+    def put(p: Params, v: float) -> Params:
+        vec = list(getattr(getattr(p, sec), name))
+        vec[k] = float(v)
+        return p.replace(**{key: vec})
+
+    return (lambda p: float(getattr(getattr(p, sec), name)[k]), put)
+
+
+def _shift_cm(p: Params, dx: float) -> Params:
+    """Move the CM forward by dx [m] (toward the nose): every body position measured from the
+    CM (CB, nose, fin points) moves aft by dx. Inertias are left unchanged (the parallel-axis
+    change, m dx^2, is below 1 % for |dx| <= 0.3 m)."""
+    d = params_to_dict(p)
+    a = d["aerostat"]
+    a["cb_position"][0] -= dx
+    a["nose_position"][0] -= dx
+    panels = [{**pan, "cp_position": [pan["cp_position"][0] - dx, *pan["cp_position"][1:]]}
+              for pan in d["fins"]["panels"]]
+    return p.replace(**{"aerostat.cb_position": a["cb_position"],
+                        "aerostat.nose_position": a["nose_position"], "fins.panels": panels})
+
+
+def _cm_knob() -> tuple[Callable, Callable]:
+    # value = forward shift relative to the shipped CM; the shipped file has shift 0
+    return (lambda p: 0.0, _shift_cm)
+
+
+def _rho_keep_lift() -> tuple[Callable, Callable]:
+    """Air density with the mass adjusted so that the net lift B - m g stays the same
+    (density and mass are not separately identifiable from Table 2, parameters.md section 2)."""
+
+    def put(p: Params, rho: float) -> Params:
+        lift = p.derived.net_lift
+        mass = (rho * p.environment.g * p.aerostat.volume - lift) / p.environment.g
+        return p.replace(**{"environment.rho_air": float(rho), "aerostat.mass": float(mass)})
+
+    return (lambda p: p.environment.rho_air, put)
+
+
+def _pm(base: float, frac: float) -> tuple[float, float]:
+    return base * (1 - frac), base * (1 + frac)
+
+
+def default_knobs(params: Params | None = None) -> list[Knob]:
+    """The uncertain parameters and their ranges (docs/parameters.md sections 1-5)."""
+    p = params or load_params()
+    a = p.aerostat
+    ks = []
+
+    def add(key, label, status, unit, lo, hi, source, getput):
+        ks.append(Knob(key, label, status, unit, float(lo), float(hi), source, *getput))
+
+    add("hull.eta_k", "hull efficiency eta_k", "CALIB", "-", 0.1, 0.5,
+        "0.1-0.25 preferred by the 67.4 s lateral pendulum, >= 0.5 yaw-divergent (sec. 5)",
+        _dotted("hull.eta_k"))
+    add("fins.CL_alpha", "fin lift slope C_L_alpha", "ESTIMATE", "1/rad", 1.2, 2.5,
+        "plausible range (sec. 1d)", _dotted("fins.CL_alpha"))
+    add("fins.planform_area", "fin planform area A_f", "ESTIMATE", "m^2", 12.0, 25.0,
+        "plausible range (sec. 1d)", _dotted("fins.planform_area"))
+    add("cm_x_shift", "CM moved forward", "CALIB", "m", -0.3, 0.3,
+        "component mass model: CM moves 0.1-0.3 m (sec. 1e)", _cm_knob())
+    xb, _, zb = a.cb_position
+    add("aerostat.cb_position[x]", "CB x relative to CM", "CALIB", "m", xb - 0.3, xb + 0.3,
+        "+-0.3 m, as the CM (sec. 1e); x_l moves 2.2x as much", _vector_component("aerostat.cb_position", 0))
+    add("aerostat.cb_position[z]", "CB z relative to CM", "CALIB", "m", zb - 0.3, zb + 0.3,
+        "+-0.3 m (sec. 1e)", _vector_component("aerostat.cb_position", 2))
+    for name in ("Ixx", "Iyy", "Izz"):
+        base = getattr(a, name)
+        add(f"aerostat.{name}", f"inertia {name}", "ESTIMATE", "kg m^2", *_pm(base, 0.3),
+            "+-30 % (sec. 1a)", _dotted(f"aerostat.{name}"))
+    add("aerostat.Ixz", "product of inertia Ixz", "ESTIMATE", "kg m^2", -abs(a.Ixz), abs(a.Ixz),
+        "sign uncertain (sec. 1a)", _dotted("aerostat.Ixz"))
+    add("hull.Cdc", "hull cross-flow drag (C_dc)_h", "ESTIMATE", "-", 0.3, 1.2,
+        "0.3-0.6 supercritical, 1.2 subcritical cylinder (sec. 1c)", _dotted("hull.Cdc"))
+    add("aerostat.k1", "axial added-mass coeff. k1", "ESTIMATE", "-", 0.086, 0.188,
+        "Table 2 fits for rho 1.225-1.120 (sec. 2)", _dotted("aerostat.k1"))
+    add("aerostat.k3", "lateral added-mass coeff. k3", "ESTIMATE", "-", 0.584, 0.803,
+        "Table 2 fits for rho 1.225-1.120 (sec. 2)", _dotted("aerostat.k3"))
+    add("environment.rho_air", "air density (net lift kept)", "DERIVED", "kg/m^3", 1.120, 1.225,
+        "Table 2 fit range, ISA sea level (sec. 2); mass adjusted", _rho_keep_lift())
+    add("hull.CD0", "hull axial drag (C_D,h)0", "ESTIMATE", "-", 0.025, 0.04,
+        "range (sec. 1c)", _dotted("hull.CD0"))
+    add("tether.Cd_normal", "tether normal drag C_dn", "ESTIMATE", "-", 1.0, 1.5,
+        "braided rope (sec. 1f)", _dotted("tether.Cd_normal"))
+    return ks
+
+
+# --- evaluation ----------------------------------------------------------------------------------
+
+
+def evaluate(params: Params, speeds=DAMPING_SPEEDS, period_speed: float = 1.0) -> dict:
+    """Table 2 periods at ``period_speed`` and the damping/stability summary over ``speeds``.
+
+    Returns
+    -------
+    dict with the four Table 2 periods [s] (keys of :data:`~.reference.TABLE2`),
+    ``min_zeta`` (smallest damping ratio of the Figure 9 modes), ``min_zeta_at`` (speed, set,
+    mode), ``all_stable`` (every mode, every speed) and ``max_real`` (largest Re lambda of a
+    non-neutral mode [1/s]); or ``error`` if a trim fails.
+    """
+    out: dict = {}
+    eq, zmin, where, stable, max_re = None, math.inf, None, True, -math.inf
+    try:
+        for u in sorted(set(speeds) | {period_speed}):
+            eq = find_equilibrium(params, u, guess=eq)
+            an = analyse(params, eq)
+            if u == period_speed:
+                out.update(linear_table2_periods(an))
+            stable &= an.all_stable()
+            max_re = max(max_re, max(m.eigenvalue.real for m in an.long + an.lat if not m.neutral))
+            for subset in SETS:
+                for label in FIGURE9_MODES[subset]:
+                    m = an.find(subset, label)
+                    if m is not None and not m.neutral and m.zeta < zmin and u in speeds:
+                        zmin, where = m.zeta, {"wind_speed_m_s": u, "set": subset, "mode": label}
+    except TrimError as exc:
+        return {"error": str(exc)}
+    out.update(min_zeta=zmin, min_zeta_at=where, all_stable=bool(stable), max_real=max_re)
+    return out
+
+
+def sensitivity_table(params: Params | None = None, knobs: list[Knob] | None = None,
+                      speeds=DAMPING_SPEEDS) -> dict:
+    """Move every knob to both ends of its range (one at a time) and evaluate.
+
+    Returns
+    -------
+    {"baseline": evaluate(params), "rows": [...]}: per knob its range and source, and for each
+    end the Table 2 periods with their % change from the baseline, the smallest damping ratio
+    and where it occurs, stability. Rows are sorted by the largest |% change| of any period.
+    """
+    p = params or load_params()
+    knobs = default_knobs(p) if knobs is None else knobs
+    base = evaluate(p, speeds)
+    rows = []
+    for k in knobs:
+        row = {"knob": k.key, "label": k.label, "status": k.status, "unit": k.unit,
+               "baseline": k.get(p), "low": k.low, "high": k.high, "source": k.source}
+        for end in ("low", "high"):
+            res = evaluate(k.put(p, getattr(k, end)), speeds)
+            row[end + "_result"] = res
+            if "error" not in res:
+                row[end + "_pct"] = {key: 100 * (res[key] - base[key]) / base[key] for key in PERIOD_KEYS}
+        row["max_abs_pct"] = max((abs(v) for end in ("low_pct", "high_pct") for v in row.get(end, {}).values()),
+                                 default=math.inf)
+        rows.append(row)
+    rows.sort(key=lambda r: -r["max_abs_pct"])
+    return {"baseline": base, "rows": rows, "speeds": list(speeds)}
+
+
+def format_sensitivity(table: dict) -> str:
+    """Plain-text table: % change of each Table 2 period at the low / high end, min zeta."""
+    short = {"long_pendulum": "long.pend", "lat_pendulum": "lat.pend", "axial_spring": "axial",
+             "tether_1st": "tether1"}
+    b = table["baseline"]
+    head = (f"{'parameter':32s} {'range':>17s} " + " ".join(f"{short[k]:>13s}" for k in PERIOD_KEYS)
+            + f" {'min zeta':>13s}")
+    lines = ["baseline: " + ", ".join(f"{short[k]} {b[k]:.3f} s" for k in PERIOD_KEYS)
+             + f", min zeta {b['min_zeta']:.3f} ({b['min_zeta_at']['set']} {b['min_zeta_at']['mode']}"
+             f" at {b['min_zeta_at']['wind_speed_m_s']:g} m/s)", "% change of each period at the low / high end of the range",
+             head, "-" * len(head)]
+    for r in table["rows"]:
+        cells = []
+        for k in PERIOD_KEYS:
+            lo, hi = r.get("low_pct", {}).get(k, math.nan), r.get("high_pct", {}).get(k, math.nan)
+            cells.append(f"{lo:+6.1f}/{hi:+6.1f}")
+        zl = r["low_result"].get("min_zeta", math.nan)
+        zh = r["high_result"].get("min_zeta", math.nan)
+        flag = "" if r["low_result"].get("all_stable", False) and r["high_result"].get("all_stable", False) else " UNSTABLE"
+        lines.append(f"{r['label']:32s} {r['low']:8.4g}-{r['high']:<8.4g} " + " ".join(f"{c:>13s}" for c in cells)
+                     + f" {zl:6.3f}/{zh:6.3f}{flag}")
+    return "\n".join(lines)
+
+
+def solve_for_period(params: Params, knob: Knob, target: float, key: str = "lat_pendulum",
+                     bracket: tuple[float, float] | None = None, wind_speed: float = 1.0,
+                     grid: int = 9, xtol: float = 1e-4) -> float | None:
+    """Value of ``knob`` that puts the Table 2 period ``key`` at ``target`` seconds at
+    ``wind_speed``; None if no value in ``bracket`` (default the knob's range) reaches it.
+
+    Notes
+    -----
+    The period need not be monotonic in the knob (at 1 m/s the lateral pendulum sits near its
+    veering with the yaw mode), so the bracket is scanned on ``grid`` points and Brent's method
+    refines the sign change nearest the knob's current value.
+    """
+    lo, hi = bracket or (knob.low, knob.high)
+
+    def f(v: float) -> float:
+        try:
+            p = knob.put(params, v)
+            return linear_table2_periods(analyse(p, find_equilibrium(p, wind_speed)))[key] - target
+        except TrimError:
+            return math.nan
+
+    xs = np.linspace(lo, hi, grid)
+    fs = np.array([f(v) for v in xs])
+    ok = np.isfinite(fs[:-1]) & np.isfinite(fs[1:]) & (fs[:-1] * fs[1:] <= 0)
+    if not ok.any():
+        return None
+    base = knob.get(params)
+    k = min(np.flatnonzero(ok), key=lambda i: abs(0.5 * (xs[i] + xs[i + 1]) - base))
+    if fs[k] == 0.0:
+        return float(xs[k])
+    return float(brentq(f, xs[k], xs[k + 1], xtol=xtol))
+
+
+def lateral_pendulum_fixes(params: Params | None = None, targets=(TABLE2["lat_pendulum"]["linear_s"] * 1.1,
+                                                                   TABLE2["lat_pendulum"]["linear_s"]),
+                           knobs: list[Knob] | None = None, widen: float = 1.0) -> list[dict]:
+    """For each knob, the value that brings the lateral pendulum at 1 m/s to each target
+    (default: the edge of the 10 % band, 74.14 s, and [LN02]'s 67.4 s), with the other Table 2
+    periods, the smallest damping ratio and stability over 1..20 m/s at that value. ``widen`` stretches the search bracket
+    beyond the stated range about its centre (1 = the range itself)."""
+    p = params or load_params()
+    rows = []
+    for k in knobs or default_knobs(p):
+        mid, half = 0.5 * (k.low + k.high), 0.5 * (k.high - k.low) * widen
+        for t in targets:
+            v = solve_for_period(p, k, t, bracket=(mid - half, mid + half))
+            row = {"knob": k.key, "label": k.label, "target_s": t, "value": v,
+                   "baseline": k.get(p), "in_range": v is not None and k.low <= v <= k.high}
+            if v is not None:
+                row["result"] = evaluate(k.put(p, v))
+            rows.append(row)
+    return rows

@@ -1,0 +1,173 @@
+"""Command-line front end of the linear stability analysis.
+
+``add_stability_parsers(subparsers)`` registers:
+
+* ``stability --wind 0:20:0.5 [--length 300] [--elements 10] [--config FILE] [--set K=V]
+  [--json] [--plot DIR]``: trim, linearize and analyse at every wind speed; print the Figure 9
+  modes (period and damping ratio), stability and the coupling ratios; ``--plot`` writes the
+  Figure 9 PNG, CSV and JSON into DIR.
+* ``table2 [--config FILE] [--json]``: [LN02] Table 2 with this model.
+* ``sensitivity [--config FILE] [--json]``: how the estimated parameters move the Table 2
+  periods and the smallest damping ratio.
+
+Each handler returns an exit status; invalid input raises ValueError (the main CLI prints it
+and exits with status 2).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+
+import numpy as np
+
+from ..params import load_params
+
+
+def parse_speeds(text: str) -> np.ndarray:
+    """"a:b:step" (inclusive), "a:b" (step 0.5) or a single speed, in m/s."""
+    try:
+        parts = [float(v) for v in text.split(":")]
+    except ValueError as exc:
+        raise ValueError(f"--wind expects START:STOP[:STEP] or a speed, got {text!r}") from exc
+    if len(parts) == 1:
+        speeds = np.array(parts)
+    elif len(parts) in (2, 3):
+        a, b = parts[:2]
+        step = parts[2] if len(parts) == 3 else 0.5
+        if step <= 0 or b < a:
+            raise ValueError(f"--wind needs START <= STOP and STEP > 0, got {text!r}")
+        speeds = np.arange(a, b + 1e-9 * max(1.0, b), step)
+    else:
+        raise ValueError(f"--wind expects START:STOP[:STEP], got {text!r}")
+    if np.any(speeds < 0) or not np.all(np.isfinite(speeds)):
+        raise ValueError(f"wind speeds must be finite and >= 0, got {text!r}")
+    return speeds
+
+
+def _set_overrides(items: list[str]) -> dict:
+    import tomllib
+
+    out = {}
+    for item in items:
+        if "=" not in item:
+            raise ValueError(f"--set expects SECTION.KEY=VALUE, got {item!r}")
+        key, raw = item.split("=", 1)
+        try:
+            out[key.strip()] = tomllib.loads(f"v = {raw}")["v"]
+        except tomllib.TOMLDecodeError:
+            out[key.strip()] = raw
+    return out
+
+
+def _params(args):
+    over = _set_overrides(getattr(args, "set", []) or [])
+    if getattr(args, "length", None) is not None:
+        over["tether.length"] = args.length
+    if getattr(args, "elements", None) is not None:
+        over["tether.n_elements"] = args.elements
+    return load_params(args.config, over or None)
+
+
+def _add_common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--config", help="parameter TOML file (default: the shipped baseline)")
+    p.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                   help="override one parameter (repeatable)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+
+def _fmt(m) -> str:
+    if m is None:
+        return f"{'-':>15s}"
+    per = f"{m.period:7.2f}" if m.oscillatory else "   real"
+    return f"{per} ({m.zeta:5.3f})"
+
+
+def _stability_text(sweep, dec_ratios: list[dict]) -> str:
+    from .modes import FIGURE9_MODES, SETS
+
+    lines = []
+    for subset, name in zip(SETS, ("Longitudinal", "Lateral"), strict=True):
+        labels = FIGURE9_MODES[subset]
+        lines.append(f"{name} modes: period [s] (damping ratio)")
+        lines.append(f"{'U m/s':>6s} " + " ".join(f"{lab[:15]:>15s}" for lab in labels))
+        tracks = dict(sweep.tracks[subset])
+        for k, u in enumerate(sweep.values):
+            cells = [_fmt(tracks[lab][k]) if lab in tracks else _fmt(None) for lab in labels]
+            lines.append(f"{u:6.2f} " + " ".join(cells))
+        lines.append("")
+    worst_ul = max(r["ul_max"] for r in dec_ratios)
+    worst_ll = max(r["ll_max"] for r in dec_ratios)
+    a0 = sweep.analyses[0]
+    n_states = a0.linear.A.shape[0]
+    lines.append(f"states {n_states} = long {a0.decoupled.A_long.shape[0]} + lat "
+                 f"{a0.decoupled.A_lat.shape[0]}; coupling blocks / max|A|: upper right <= "
+                 f"{worst_ul:.1e}, lower left <= {worst_ll:.1e}")
+    lines.append(f"all modes stable at every speed: {sweep.all_stable()}   "
+                 f"({len(sweep.values)} speeds, trims included, in {sweep.seconds:.2f} s)")
+    return "\n".join(lines)
+
+
+def cmd_stability(args) -> int:
+    from .figures import figure9_data, write_figure9
+    from .modes import wind_sweep
+
+    params = _params(args)
+    speeds = parse_speeds(args.wind)
+    sweep = wind_sweep(params, speeds)
+    ratios = [a.decoupled.ratios for a in sweep.analyses]
+    if args.plot:
+        write_figure9(args.plot, params, sweep=sweep)
+    if args.json:
+        out = {"tether_length_m": params.tether.length, "n_elements": params.tether.n_elements,
+               "all_stable": sweep.all_stable(), "seconds": sweep.seconds,
+               "coupling_ratios": ratios, "figure9": figure9_data(sweep),
+               "modes": sweep.rows()}
+        print(json.dumps(out, indent=1, default=_json_default))
+    else:
+        print(f"Linear stability, L = {params.tether.length:g} m, n = {params.tether.n_elements}, "
+              f"trim pitch {params.aerostat.trim_pitch_deg:g} deg")
+        print(_stability_text(sweep, ratios))
+    return 0
+
+
+def _json_default(v):
+    if isinstance(v, (np.floating, np.integer)):
+        return v.item()
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    raise TypeError(f"not JSON serialisable: {type(v)}")
+
+
+def cmd_table2(args) -> int:
+    from .reference import format_table2, table2
+
+    rows = table2(_params(args))
+    print(json.dumps(rows, indent=1) if args.json else format_table2(rows))
+    return 0
+
+
+def cmd_sensitivity(args) -> int:
+    from .sensitivity import format_sensitivity, sensitivity_table
+
+    table = sensitivity_table(_params(args))
+    print(json.dumps(table, indent=1, default=_json_default) if args.json else format_sensitivity(table))
+    return 0
+
+
+def add_stability_parsers(subparsers) -> None:
+    """Register ``stability``, ``table2`` and ``sensitivity`` on an argparse subparsers object."""
+    p = subparsers.add_parser("stability", help="linear stability against wind speed ([LN02] Fig. 9)")
+    p.add_argument("--wind", default="0:20:0.5", help="START:STOP[:STEP] m/s (default 0:20:0.5)")
+    p.add_argument("--length", type=float, default=None, help="tether length [m] (default: config)")
+    p.add_argument("--elements", type=int, default=None, help="tether elements n (default: config)")
+    p.add_argument("--plot", metavar="DIR", help="write figure9.png/.csv/.json into DIR")
+    _add_common(p)
+    p.set_defaults(func=cmd_stability)
+    p = subparsers.add_parser("table2", help="[LN02] Table 2: reference vs linear-model periods")
+    _add_common(p)
+    p.set_defaults(func=cmd_table2)
+    p = subparsers.add_parser("sensitivity", help="Table 2 periods and damping vs uncertain parameters")
+    _add_common(p)
+    p.set_defaults(func=cmd_sensitivity)
