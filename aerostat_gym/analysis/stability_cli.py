@@ -47,18 +47,10 @@ def parse_speeds(text: str) -> np.ndarray:
 
 
 def _set_overrides(items: list[str]) -> dict:
-    import tomllib
+    """``--set SECTION.KEY=VALUE`` items, parsed exactly as the main CLI does."""
+    from ..cli import _overrides
 
-    out = {}
-    for item in items:
-        if "=" not in item:
-            raise ValueError(f"--set expects SECTION.KEY=VALUE, got {item!r}")
-        key, raw = item.split("=", 1)
-        try:
-            out[key.strip()] = tomllib.loads(f"v = {raw}")["v"]
-        except tomllib.TOMLDecodeError:
-            out[key.strip()] = raw
-    return out
+    return _overrides(items)
 
 
 def _params(args):
