@@ -20,6 +20,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 try:  # Python >= 3.11
     import tomllib
 except ModuleNotFoundError:  # pragma: no cover
@@ -71,6 +73,12 @@ class AerostatParams:
     trim_pitch_deg: float = _f("deg", "SOURCED", ANY, "zero-wind trim pitch (negative = nose up)")
     k1: float = _f("-", "ESTIMATE", NONNEG, "axial added-mass coefficient")
     k3: float = _f("-", "ESTIMATE", NONNEG, "lateral added-mass coefficient (y and z)")
+
+    @property
+    def inertia_tensor(self) -> np.ndarray:
+        """Inertia tensor about the CM in body axes [kg m^2]. Ixz = integral(x z dm), so the
+        tensor's off-diagonal entry is -Ixz; Ixy = Iyz = 0 by the x-z plane of symmetry."""
+        return np.array([[self.Ixx, 0.0, -self.Ixz], [0.0, self.Iyy, 0.0], [-self.Ixz, 0.0, self.Izz]])
 
 
 @dataclass(frozen=True)

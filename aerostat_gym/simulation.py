@@ -122,13 +122,10 @@ class Model:
         d = w[3 * (n - 1):3 * n] - w[3 * n:3 * n + 3]
         e = d / np.linalg.norm(d)
         L = x[self.layout.winch_length]
-        half = 0.5 * self.p_mass_per_length * L / n * self.params.environment.g
+        half = 0.5 * self.params.derived.mass_per_length * L / n * self.params.environment.g
         bottom = float(np.linalg.norm(T * e - np.array([0.0, 0.0, half])))
         return top, bottom
 
-    @property
-    def p_mass_per_length(self) -> float:
-        return self.params.derived.mass_per_length
 
     def rk4_dt(self, length: float | None = None) -> float:
         """RK4 step from the axial stability bound at the given (default: configured) length."""

@@ -26,10 +26,9 @@ def mechanical_energy(model: Model, x: np.ndarray) -> float:
     R = rotation_matrix(*x[lay.euler])
     vb = R.T @ x[lay.cm_vel]
     a = prm.aerostat
-    inertia = np.array([[a.Ixx, 0, -a.Ixz], [0, a.Iyy, 0], [-a.Ixz, 0, a.Izz]])
     om = x[lay.rates]
     kinetic = (0.5 * m_node * np.sum(x[lay.node_vel] ** 2)
-               + 0.5 * vb @ (np.array(d.effective_mass) * vb) + 0.5 * om @ inertia @ om)
+               + 0.5 * vb @ (np.array(d.effective_mass) * vb) + 0.5 * om @ a.inertia_tensor @ om)
     nodes = model.node_positions(x)
     z_cb = x[lay.cm_pos][2] + (R @ np.array(a.cb_position))[2]
     potential = (m_node * g * np.sum(nodes[1:-1, 2]) + 0.5 * m_node * g * nodes[0, 2]

@@ -63,10 +63,10 @@ def _params(args):
 
 
 def _add_common(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--config", help="parameter TOML file (default: the shipped baseline)")
-    p.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                   help="override one parameter (repeatable)")
-    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    """``--config``, ``--set`` and ``--json``, exactly as the main CLI defines them."""
+    from ..cli import _add_config
+
+    _add_config(p)
 
 
 def _fmt(m) -> str:

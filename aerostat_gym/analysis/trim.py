@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..params import Params, load_params
+from ..physics.core import rotation_matrix
 from ..physics.wind import pack_wind
 from ..simulation import Model
 
@@ -54,13 +55,10 @@ def _residual(model: Model, x: np.ndarray) -> np.ndarray:
     L = x[lay.winch_length]
     m_node = d.mass_per_length * L / model.n
     node_f = m_node * dx[lay.node_vel]
-    from ..physics.core import rotation_matrix
-
     R = rotation_matrix(*x[lay.euler])
     body_f = np.array(d.effective_mass) * (R.T @ dx[lay.cm_vel])
     a = model.params.aerostat
-    inertia = np.array([[a.Ixx, 0, -a.Ixz], [0, a.Iyy, 0], [-a.Ixz, 0, a.Izz]])
-    moment = inertia @ dx[lay.rates] / a.length
+    moment = a.inertia_tensor @ dx[lay.rates] / a.length
     return np.concatenate([node_f, body_f, moment])
 
 
@@ -84,8 +82,6 @@ def zero_wind_state(params: Params, length: float | None = None) -> np.ndarray:
     th = math.radians(params.aerostat.trim_pitch_deg)
     psi = math.radians(params.wind.direction_deg) + math.pi
     x[lay.euler] = [0.0, th, psi]
-    from ..physics.core import rotation_matrix
-
     R = rotation_matrix(0.0, th, psi)
     confluence = np.array([anchor[0], anchor[1], z_nodes[0]])
     x[lay.cm_pos] = confluence - R @ np.array(d.leash_position)

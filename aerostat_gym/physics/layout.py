@@ -113,9 +113,7 @@ def pack_params(params: Params) -> np.ndarray:
     p[P_G], p[P_RHO], p[P_MASS], p[P_BUOY] = env.g, env.rho_air, a.mass, d.buoyancy
     p[P_ME:P_ME + 3] = d.effective_mass
     p[P_MA:P_MA + 3] = d.added_mass
-    inertia = np.array([[a.Ixx, 0.0, -a.Ixz], [0.0, a.Iyy, 0.0], [-a.Ixz, 0.0, a.Izz]])
-    # Inertia tensor with the product of inertia Ixz = integral(x z dm): the off-diagonal entry of
-    # the tensor is -Ixz (standard rigid-body convention, [LN02] eq. for M_cm).
+    inertia = a.inertia_tensor
     p[P_INERTIA:P_INERTIA + 9] = inertia.ravel()
     p[P_IINV:P_IINV + 9] = np.linalg.inv(inertia).ravel()
     p[P_CB:P_CB + 3] = a.cb_position
