@@ -116,10 +116,12 @@ def _extra_benches():
     else:
         yield "moordyn_comparison", compare_with_moordyn
     from .analysis.bench_linear import bench_sweep
+    from .envs.bench import bench_env
     from .wind.bench import bench_wind
 
     yield "wind", lambda quick: bench_wind()
     yield "linear_sweep", lambda quick: bench_sweep()
+    yield "environment", bench_env
 
 
 def format_text(res: dict, indent: int = 0) -> str:

@@ -2,7 +2,8 @@
 
 Commands: ``trim`` (equilibrium summary), ``params`` (every parameter with its unit and status),
 ``bench`` (speed and accuracy figures), ``wind`` (turbulence statistics), ``stability``,
-``table2`` and ``sensitivity`` (linear stability analysis). Errors in user input print one clear line and exit with status 2.
+``table2`` and ``sensitivity`` (linear stability analysis), ``train``, ``evaluate`` and ``demo``
+(winch-control agents). Errors in user input print one clear line and exit with status 2.
 """
 
 from __future__ import annotations
@@ -98,6 +99,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_wind_parser(sub)
     add_stability_parsers(sub)
+    from .agents.cli import add_agent_parsers
+
+    add_agent_parsers(sub)
     return ap
 
 

@@ -104,7 +104,7 @@ class FinPanel:
 class FinParams:
     planform_area: float = _f("m^2", "ESTIMATE", NONNEG, "planform area per fin")
     aspect_ratio: float = _f("-", "ESTIMATE", POSITIVE, "aspect ratio used for induced drag")
-    CL_alpha: float = _f("1/rad", "ESTIMATE", NONNEG, "3-D lift slope incl. interference loss")
+    CL_alpha: float = _f("1/rad", "CALIB", NONNEG, "3-D lift slope incl. hull interference loss; calibrated (0.68 x McCormick) to the 67.4 s lateral pendulum")
     alpha_stall_deg: float = _f("deg", "ESTIMATE", STALL, "stall angle; C_L flat beyond it")
     CD0: float = _f("-", "ESTIMATE", NONNEG, "parasite drag coefficient")
     oswald_e: float = _f("-", "ESTIMATE", POSITIVE, "Oswald efficiency")
@@ -469,7 +469,8 @@ class Derived:
             element_mass=mu * l_u,
             critical_damping=b_c,
             damping_b=t.damping_ratio * b_c,
-            dashpot=t.damping_ratio * b_c / l_u,
+            # b / l_u written without l_u, so that it is bitwise independent of the length
+            dashpot=t.damping_ratio * 2.0 * area * math.sqrt(t.youngs_modulus * t.density),
             added_mass=ma,
             effective_mass=tuple(a.mass + m for m in ma),
             tether_weight=mu * t.length * env.g,

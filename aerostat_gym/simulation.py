@@ -18,6 +18,7 @@ from .physics.core import evaluate_tether, work_size
 from .physics.core import rhs as _rhs
 from .physics.integrators import NONFINITE, rk4_advance, rk4_step, si_advance
 from .physics.layout import N_INPUTS, StateLayout, pack_params
+from .physics.outputs import confluence_tension, winch_end_tension
 from .physics.wind import NO_FIELD, pack_wind, wind_from_params
 from .winch import WinchController
 
@@ -115,16 +116,7 @@ class Model:
         there), the bottom end |T e - (mu l_u / 2) g z_hat| of the last element.
         """
         w = self._forces(x, t)
-        n = self.n
-        F = 6 * (n + 1)
-        top = float(np.linalg.norm(w[F:F + 3]))
-        T = w[9 * (n + 1) + n - 1]
-        d = w[3 * (n - 1):3 * n] - w[3 * n:3 * n + 3]
-        e = d / np.linalg.norm(d)
-        L = x[self.layout.winch_length]
-        half = 0.5 * self.params.derived.mass_per_length * L / n * self.params.environment.g
-        bottom = float(np.linalg.norm(T * e - np.array([0.0, 0.0, half])))
-        return top, bottom
+        return float(confluence_tension(self.p, w)), float(winch_end_tension(x, self.p, w))
 
 
     def rk4_dt(self, length: float | None = None) -> float:

@@ -36,6 +36,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from .params import Params, load_params
 from .physics.layout import StateLayout
@@ -101,6 +102,22 @@ def parse_command(u) -> tuple[float, bool]:
     return v, brake != 0.0
 
 
+@njit(cache=True)
+def brake_rule(v, brake_cmd, braked, v_w, max_speed, brake_speed, hold_speed):
+    """One control step of the winch's supervisory logic; returns (v_set, brake, v_w).
+
+    The brake is wanted when commanded or when |v| < brake_speed. It clamps the drum (v_w set to
+    exactly 0) if it already held it or once |v_w| <= hold_speed; until then the speed loop
+    decelerates the drum with set-point 0. Released, the set-point is clipped to +-max_speed.
+    Compiled so the environment's compiled step applies the same rule.
+    """
+    if brake_cmd or abs(v) < brake_speed:
+        if braked or abs(v_w) <= hold_speed:
+            return 0.0, True, 0.0
+        return 0.0, False, v_w
+    return min(max(v, -max_speed), max_speed), False, v_w
+
+
 class WinchController:
     """Per-control-step winch logic (see the module docstring). One instance per episode.
 
@@ -149,18 +166,13 @@ class WinchController:
         clipped = abs(v) > w.max_speed and not brake_cmd  # a commanded brake ignores v_set
         self.n_steps += 1
         self.n_clipped += int(clipped)
-        v_clip = min(max(v, -w.max_speed), w.max_speed)
-        if brake_cmd or abs(v) < w.brake_speed:
-            iv = self.layout.winch_speed
-            if self.braked or abs(x[iv]) <= w.brake_hold_speed:
-                clamped = not self.braked
-                x[iv] = 0.0  # the brake holds the drum still: no residual reel speed
-                self.braked = True
-                return WinchCommand(v, 0.0, True, clipped, clamped)
-            self.braked = False
-            return WinchCommand(v, 0.0, False, clipped, False)  # decelerate first
-        self.braked = False
-        return WinchCommand(v, v_clip, False, clipped, False)
+        iv = self.layout.winch_speed
+        v_set, brake, v_w = brake_rule(v, brake_cmd, self.braked, x[iv], w.max_speed,
+                                       w.brake_speed, w.brake_hold_speed)
+        clamped = brake and not self.braked
+        x[iv] = v_w  # exactly 0 once the brake holds the drum
+        self.braked = brake
+        return WinchCommand(v, v_set, brake, clipped, clamped)
 
     # --- measurements and bookkeeping ----------------------------------------------------------
 

@@ -179,11 +179,10 @@ def test_table2_linear_model_within_3pct(t2, key):
     assert abs(t2[key]["vs_paper_linear_pct"]) <= 3.0, t2[key]
 
 
-@pytest.mark.xfail(strict=False, reason="lateral pendulum 75.6 s at U = 1 m/s, +12.1 % from "
-                   "[LN02]'s 67.4 s: set by estimated yaw aerodynamics (see sensitivity); "
-                   "left for a documented calibration")
 def test_table2_lateral_pendulum_within_10pct(t2):
-    """Lateral pendulum at U = 1 m/s within 10 % of 67.4 s (issue 3 target)."""
+    """Lateral pendulum at U = 1 m/s within 10 % of 67.4 s (issue 3 target). Met through the
+    CALIB fin lift slope fins.CL_alpha = 1.43 /rad (67.58 s, +0.3 %); with the former 1.79 /rad
+    ESTIMATE it was 75.6 s (+12.1 %)."""
     assert abs(t2["lat_pendulum"]["vs_paper_linear_pct"]) <= 10.0, t2["lat_pendulum"]
 
 
@@ -213,13 +212,17 @@ def test_pendulum_shape_linear_and_harmonic_shape(sweep):
 
 
 def test_pendulum_damping_rises_with_wind(sweep):
-    """Longitudinal pendulum damping never decreases from 0 to 20 m/s (0 -> 0.40). Lateral
-    pendulum: never decreases from 3 to 20 m/s (0.039 -> 0.132); below 3 m/s it peaks at
-    0.134 near 1 m/s, where the yaw mode's period crosses the pendulum's (mode veering)."""
+    """Longitudinal pendulum damping never decreases from 0 to 20 m/s (0 -> 0.39). Lateral
+    pendulum: never decreases from 4.5 to 20 m/s (0.068 -> 0.142); below it the damping peaks
+    at 0.27 at 1 m/s, where the yaw mode's period crosses the pendulum's (mode veering), and
+    relaxes to the 0.068 minimum at 4.5 m/s. The veering speed is set by the yaw stiffness:
+    with the CALIB fin lift slope 1.43 /rad (67.4 s lateral pendulum) the relaxation ends at
+    4.5 m/s; with the former 1.79 /rad estimate it ended at 3 m/s, at a lower minimum (0.039)."""
     z_long = sweep.curve("long", "pendulum", "zeta")
     assert np.all(np.diff(z_long) >= -1e-6) and z_long[-1] > 0.3
     z_lat = sweep.curve("lat", "pendulum", "zeta")
-    high = sweep.values >= 3.0
+    assert z_lat[sweep.values >= 1.0].min() > 0.06
+    high = sweep.values >= 4.5
     assert np.all(np.diff(z_lat[high]) >= -1e-6) and z_lat[-1] > 2 * z_lat[high][0]
 
 
@@ -256,16 +259,28 @@ def fig8(base):
 
 
 def test_figure8_paper_amplitude_regression(fig8):
-    """[LN02] amplitude, nodes at trim: nRMS x 21.4 %, y 7.1 %, z 5.5 %, phi 6.7 %, theta 8.0 %,
-    psi 5.7 % (regression band: 1.2 x these)."""
-    measured = {"x": 0.214, "y": 0.071, "z": 0.055, "phi": 0.067, "theta": 0.080, "psi": 0.057}
+    """[LN02] amplitude, nodes at trim: nRMS x 22.5 %, y 9.0 %, z 5.8 %, phi 8.3 %, theta 8.2 %,
+    psi 7.6 % (regression band: 1.2 x these)."""
+    measured = {"x": 0.225, "y": 0.090, "z": 0.058, "phi": 0.083, "theta": 0.082, "psi": 0.076}
     for k, v in measured.items():
         assert fig8["nrms"][k] <= 1.2 * v, (k, fig8["nrms"][k])
 
 
-@pytest.mark.xfail(strict=False, reason="nonlinear effects of the 0.1 m / 0.01 rad kick (the top "
-                   "element's tension more than doubles): nRMS 5.5-21 %; <= 5 % holds up to 0.2 x "
-                   "the amplitude")
+def test_figure8_relaxed_tether_regression(base):
+    """[LN02] amplitude, tether nodes in the linear static equilibrium for the displaced
+    aerostat ("relaxed"): nRMS x 13.7 %, y 8.9 %, z 3.7 %, phi 8.3 %, theta 6.6 %, psi 7.5 %
+    (regression band: 1.2 x these); x, z and theta lower than with the nodes at trim."""
+    d = figure8_data(base, tether_nodes="relaxed")
+    assert d["status"] == "ok"
+    measured = {"x": 0.137, "y": 0.089, "z": 0.037, "phi": 0.083, "theta": 0.066, "psi": 0.075}
+    for k, v in measured.items():
+        assert d["nrms"][k] <= 1.2 * v, (k, d["nrms"][k])
+
+
+@pytest.mark.xfail(strict=False, reason="second-order effects of the 0.1 m / 0.01 rad kick: "
+                   "nRMS 6-23 % with the nodes at trim, 4-14 % with relaxed nodes; the nRMS scale "
+                   "in proportion to the amplitude (quadratic terms), a lateral-only kick is "
+                   "linear to 0.04 %, so the lateral misses are longitudinal x lateral coupling")
 def test_figure8_paper_amplitude_within_5pct(fig8):
     """Issue 3 target: nRMS <= 5 % for each of the six variables at [LN02]'s amplitude."""
     assert max(fig8["nrms"].values()) <= 0.05, fig8["nrms"]
@@ -285,12 +300,12 @@ def test_figure9_outputs(sweep, tmp_path):
 
 
 def test_sensitivity_eta_k_moves_lateral_pendulum_only(base):
-    """eta_k 0.1 shortens the lateral pendulum at 1 m/s by > 5 % and moves the longitudinal
-    Table 2 periods by < 0.5 %."""
+    """eta_k 0.3 (baseline 0.4) lengthens the lateral pendulum at 1 m/s by > 5 % (67.6 -> 74.7 s)
+    and moves the longitudinal Table 2 periods by < 0.5 %."""
     knob = next(k for k in default_knobs(base) if k.key == "hull.eta_k")
     b = evaluate(base, speeds=(1.0,))
-    lo = evaluate(knob.put(base, 0.1), speeds=(1.0,))
-    assert lo["lat_pendulum"] < 0.95 * b["lat_pendulum"]
+    lo = evaluate(knob.put(base, 0.3), speeds=(1.0,))
+    assert lo["lat_pendulum"] > 1.05 * b["lat_pendulum"]
     for key in ("long_pendulum", "axial_spring", "tether_1st"):
         assert lo[key] == pytest.approx(b[key], rel=0.005)
 

@@ -113,10 +113,10 @@ def default_knobs(params: Params | None = None) -> list[Knob]:
         ks.append(Knob(key, label, status, unit, float(lo), float(hi), source, *getput))
 
     add("hull.eta_k", "hull efficiency eta_k", "CALIB", "-", 0.1, 0.5,
-        "0.1-0.25 preferred by the 67.4 s lateral pendulum, >= 0.5 yaw-divergent (sec. 5)",
+        ">= 0.5 yaw-divergent (sec. 5); with C_L_alpha 1.79 the 67.4 s pendulum wanted 0.1-0.25",
         _dotted("hull.eta_k"))
-    add("fins.CL_alpha", "fin lift slope C_L_alpha", "ESTIMATE", "1/rad", 1.2, 2.5,
-        "plausible range (sec. 1d)", _dotted("fins.CL_alpha"))
+    add("fins.CL_alpha", "fin lift slope C_L_alpha", "CALIB", "1/rad", 1.2, 2.5,
+        "plausible range (sec. 1d); 1.43 calibrated to the 67.4 s lateral pendulum", _dotted("fins.CL_alpha"))
     add("fins.planform_area", "fin planform area A_f", "ESTIMATE", "m^2", 12.0, 25.0,
         "plausible range (sec. 1d)", _dotted("fins.planform_area"))
     add("cm_x_shift", "CM moved forward", "CALIB", "m", -0.3, 0.3,

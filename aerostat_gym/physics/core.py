@@ -98,10 +98,21 @@ FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
 # Work-array layout: node positions, velocities and forces, 3 (n + 1) each (node 0 = confluence
 # point, node n = anchor); the n element tensions; the wind sample points (n element midpoints,
-# the hull point, the fin points), 3 each, followed by the air velocity at each of them.
+# the hull point, the fin points), 3 each, followed by the air velocity at each of them; then the
+# tether's per-element scratch: (v_t, |v_n|^2) pairs, 2 n, and unit vectors e, 3 n.
+#
+# The loops index the work array through views (w[a:b]) with indices from range(): numba wraps
+# negative indices, and with an offset computed at run time (w[base + i]) every access carries
+# that select, which also keeps LLVM from vectorizing. Measured: 0.42 -> 0.29 us per call.
 
 
 def work_size(n: int) -> int:
+    return _scratch(n) + 5 * n
+
+
+@njit(cache=True, inline="always")
+def _scratch(n):
+    """Offset of the tether's per-element scratch (5 n floats) in the work array."""
     return _pts(n) + 6 * (n + 1 + MAX_FINS)
 
 
@@ -121,24 +132,27 @@ _ATAN_C = (0.999999999996503, -0.3333333310350973, 0.19999984562222467, -0.14285
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _atan01(r):
+    """r P(r^2) evaluated by Estrin's scheme: the Horner sum regrouped into independent pairs,
+    so the dependency chain is ~5 multiply-adds deep instead of 13."""
     z = r * r
+    z2 = z * z
+    z4 = z2 * z2
     c = _ATAN_C
-    return r * (c[0] + z * (c[1] + z * (c[2] + z * (c[3] + z * (c[4] + z * (c[5] + z * (c[6] + z * (
-        c[7] + z * (c[8] + z * (c[9] + z * (c[10] + z * (c[11] + z * c[12]))))))))))))
+    lo = (c[0] + z * c[1]) + z2 * (c[2] + z * c[3]) + z4 * ((c[4] + z * c[5]) + z2 * (c[6] + z * c[7]))
+    hi = (c[8] + z * c[9]) + z2 * (c[10] + z * c[11]) + z4 * c[12]
+    return r * (lo + (z4 * z4) * hi)
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def fast_atan2(y, x):
-    """atan2(y, x) to 1e-11 rad via octant reduction and :data:`_ATAN_C`."""
+    """atan2(y, x) to 1e-11 rad via octant reduction and :data:`_ATAN_C`. Written with selects
+    rather than branches (the signs flip with the state, so branches would mispredict);
+    atan2(0, 0) = 0."""
     ax, ay = abs(x), abs(y)
-    if ax == 0.0 and ay == 0.0:
-        return 0.0
-    if ay <= ax:
-        a = _atan01(ay / ax)
-    else:
-        a = 0.5 * math.pi - _atan01(ax / ay)
-    if x < 0.0:
-        a = math.pi - a
+    swap = ay > ax
+    a = _atan01(min(ax, ay) / max(ax, ay, 1e-300))
+    a = 0.5 * math.pi - a if swap else a
+    a = math.pi - a if x < 0.0 else a
     return -a if y < 0.0 else a
 
 
@@ -180,11 +194,14 @@ def _kinematics(x, p, R, w):
         w[V + k] = x[o + 3 + k] + R[3 * k] * wx + R[3 * k + 1] * wy + R[3 * k + 2] * wz
         w[P + 3 * n + k] = p[P_ANCHOR + k]
         w[V + 3 * n + k] = 0.0
+    # views: indices from range() are known non-negative (no wraparound selects)
+    pos, vel, mid = w[:3 * (n + 1)], w[3 * (n + 1):6 * (n + 1)], w[PT:PT + 3 * n]
+    xp, xv = x[:3 * nm], x[3 * nm:6 * nm]
     for i in range(3 * nm):
-        w[P + 3 + i] = x[i]
-        w[V + 3 + i] = x[3 * nm + i]
+        pos[3 + i] = xp[i]
+        vel[3 + i] = xv[i]
     for i in range(3 * n):
-        w[PT + i] = 0.5 * (w[P + i] + w[P + 3 + i])
+        mid[i] = 0.5 * (pos[i] + pos[3 + i])
     nf = int(p[P_NFIN])
     for c in range(nf + 1):
         b = P_CB if c == 0 else P_FIN + 9 * (c - 1)
@@ -201,22 +218,22 @@ def wind_batch(t, w, npts, base, wp, wf):
     Branches once on the wind features: a steady mean wind (the trim and the paper's case)
     takes a short path; gusts and turbulence go through :func:`air_velocity` point by point.
     """
-    out = base + 3 * npts
+    pts, out = w[base:base + 3 * npts], w[base + 3 * npts:base + 6 * npts]
     if wp[W_GUST_ON] == 0.0 and (wp[W_TURB_ON] == 0.0 or wf.shape[1] < 2):
         c, s = wp[W_DIRC], wp[W_DIRS]
         uniform = wp[W_PROFILE] == 0.0
         u0 = wp[W_UREF]
         for i in range(npts):
-            um = u0 if uniform else mean_speed(w[base + 3 * i + 2], wp)
-            w[out + 3 * i] = c * um
-            w[out + 3 * i + 1] = s * um
-            w[out + 3 * i + 2] = 0.0
+            um = u0 if uniform else mean_speed(pts[3 * i + 2], wp)
+            out[3 * i] = c * um
+            out[3 * i + 1] = s * um
+            out[3 * i + 2] = 0.0
         return
     for i in range(npts):
-        ax, ay, az = air_velocity(w[base + 3 * i], w[base + 3 * i + 1], w[base + 3 * i + 2], t, wp, wf)
-        w[out + 3 * i] = ax
-        w[out + 3 * i + 1] = ay
-        w[out + 3 * i + 2] = az
+        ax, ay, az = air_velocity(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], t, wp, wf)
+        out[3 * i] = ax
+        out[3 * i + 1] = ay
+        out[3 * i + 2] = az
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -225,44 +242,87 @@ def _tether(x, p, w):
     winds already in the work array. Node 0's force acts on the aerostat. Returns the
     winch-end element tension.
 
-    The element pass is branch-free so that LLVM vectorizes it; the per-element force
-    (T e and the drag) is then scattered to the two end nodes.
+    Three passes over the elements: geometry and tension (:func:`_element_geometry`), the drag
+    magnitudes (:func:`_element_drag`, branch-free on contiguous pairs, so LLVM vectorizes its
+    square roots, divisions and arctangent), then the per-element forces gathered at the nodes
+    (:func:`_node_forces`). Short loop bodies also let the out-of-order core overlap the
+    square-root/division chains of consecutive elements.
     """
     n = int(p[P_NEL])
+    _element_geometry(x, p, w, n)
+    _element_drag(x, p, w, n)
+    _node_forces(x, p, w, n)
+    return w[9 * (n + 1) + n - 1]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _element_geometry(x, p, w, n):
+    """Per element: unit vector e (upper minus lower node), tension, and the midpoint velocity
+    relative to the air split into its tangential part v_t = v.e and normal part v_n."""
     o = 6 * (n - 1)
     L = x[o + 12]
     l_u = L / n
     il_u = 1.0 / l_u
     rate = x[o + 13] / L  # Ldot / L: the strain rate's unstretched-length term
-    m_node = p[P_MU] * l_u
     EA, cs = p[P_EA], p[P_DASHPOT]
-    qd = 0.5 * p[P_RHO] * p[P_CDN] * p[P_DIAM] * l_u
-    f0, f1, f2, f3, f4 = p[P_FN], p[P_FN + 1], p[P_FN + 2], p[P_FN + 3], p[P_FN + 4]
-    t0, t1, t2, t3, t4, t5 = p[P_FT], p[P_FT + 1], p[P_FT + 2], p[P_FT + 3], p[P_FT + 4], p[P_FT + 5]
-    P, V, F, T0 = 0, 3 * (n + 1), 6 * (n + 1), 9 * (n + 1)
-    WN = _pts(n) + 3 * (n + 1 + int(p[P_NFIN]))
-    # element pass; the upper node's force (-T e + D/2) goes to the F slots of node e+1 for now
+    # views of the work array (indices from range() are then known non-negative: no
+    # wraparound selects in the loop)
+    pos, vel, ten = w[:3 * (n + 1)], w[3 * (n + 1):6 * (n + 1)], w[9 * (n + 1):9 * (n + 1) + n]
+    wn, vv, ev = _element_views(p, w, n)
     for e in range(n):
         a = 3 * e
-        dx = w[P + a] - w[P + a + 3]
-        dy = w[P + a + 1] - w[P + a + 4]
-        dz = w[P + a + 2] - w[P + a + 5]
+        dx = pos[a] - pos[a + 3]
+        dy = pos[a + 1] - pos[a + 4]
+        dz = pos[a + 2] - pos[a + 5]
         ln = math.sqrt(dx * dx + dy * dy + dz * dz)
         il = 1.0 / ln
         ex, ey, ez = dx * il, dy * il, dz * il
         # tension only: a slack element carries nothing, and damping cannot push
-        T = EA * (ln * il_u - 1.0) + cs * (ex * (w[V + a] - w[V + a + 3]) + ey * (w[V + a + 1] - w[V + a + 4])
-                                         + ez * (w[V + a + 2] - w[V + a + 5]) - ln * rate)
-        T = max(T, 0.0) if ln > l_u else 0.0
-        w[T0 + e] = T
-        # Morison drag with loading functions, from the midpoint velocity relative to the air:
-        # D = q |v|^2 [f_n(phi) (-v_n/|v_n|) + f_t(phi) (-sign(v.e) e)], phi in [0, pi/2]
-        vx = 0.5 * (w[V + a] + w[V + a + 3]) - w[WN + a]
-        vy = 0.5 * (w[V + a + 1] + w[V + a + 4]) - w[WN + a + 1]
-        vz = 0.5 * (w[V + a + 2] + w[V + a + 5]) - w[WN + a + 2]
+        T = EA * (ln * il_u - 1.0) + cs * (ex * (vel[a] - vel[a + 3]) + ey * (vel[a + 1] - vel[a + 4])
+                                         + ez * (vel[a + 2] - vel[a + 5]) - ln * rate)
+        ten[e] = max(T, 0.0) if ln > l_u else 0.0
+        # midpoint velocity relative to the air; its normal component, one definition
+        vx = 0.5 * (vel[a] + vel[a + 3]) - wn[a]
+        vy = 0.5 * (vel[a + 1] + vel[a + 4]) - wn[a + 1]
+        vz = 0.5 * (vel[a + 2] + vel[a + 5]) - wn[a + 2]
         vt = vx * ex + vy * ey + vz * ez
-        nx, ny, nz = vx - vt * ex, vy - vt * ey, vz - vt * ez  # normal component, one definition
-        vn2 = nx * nx + ny * ny + nz * nz
+        nx, ny, nz = vx - vt * ex, vy - vt * ey, vz - vt * ez
+        vv[2 * e] = vt
+        vv[2 * e + 1] = nx * nx + ny * ny + nz * nz
+        wn[a] = nx  # the wind at the midpoint is no longer needed
+        wn[a + 1] = ny
+        wn[a + 2] = nz
+        ev[a] = ex
+        ev[a + 1] = ey
+        ev[a + 2] = ez
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _element_views(p, w, n):
+    """Per-element slots of the work array: the wind at the element midpoints (overwritten by
+    the normal relative velocity v_n), the (v_t, |v_n|^2) pairs (overwritten by the drag
+    factors), the unit vectors e."""
+    WN = _pts(n) + 3 * (n + 1 + int(p[P_NFIN]))
+    S = _scratch(n)
+    return w[WN:WN + 3 * n], w[S:S + 2 * n], w[S + 2 * n:S + 5 * n]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _element_drag(x, p, w, n):
+    """Morison drag with loading functions, from the midpoint velocity v relative to the air:
+    D = q |v|^2 [f_n(phi) (-v_n/|v_n|) + f_t(phi) (-sign(v.e) e)], phi in [0, pi/2] the angle
+    between v and the element axis. Stores D = k_n v_n + k_t e as the two factors (k_n, k_t)."""
+    o = 6 * (n - 1)
+    l_u = x[o + 12] / n
+    qd = 0.5 * p[P_RHO] * p[P_CDN] * p[P_DIAM] * l_u
+    f0, f1, f2, f3, f4 = p[P_FN], p[P_FN + 1], p[P_FN + 2], p[P_FN + 3], p[P_FN + 4]
+    t0, t1, t2, t3, t4, t5 = p[P_FT], p[P_FT + 1], p[P_FT + 2], p[P_FT + 3], p[P_FT + 4], p[P_FT + 5]
+    # in place on the (v_t, |v_n|^2) pairs; a view, so the indices are known non-negative
+    # (no wraparound select) and the loop vectorizes
+    vv = _element_views(p, w, n)[1]
+    for e in range(n):
+        vt = vv[2 * e]
+        vn2 = vv[2 * e + 1]
         v2 = vt * vt + vn2
         at = abs(vt)
         vn = math.sqrt(vn2)
@@ -271,33 +331,39 @@ def _tether(x, p, w):
         r = _atan01(min(at, vn) / max(at, vn, 1e-150))
         phi = r if vn <= at else 0.5 * math.pi - r
         fn = f0 + f1 * c + f2 * s + f3 * (2.0 * c * c - 1.0) + f4 * 2.0 * s * c
-        ft = t0 + phi * (t1 + phi * (t2 + phi * (t3 + phi * (t4 + phi * t5))))
-        kn = -qd * v2 * fn / vn if vn > 0.0 else 0.0
-        kt = -qd * v2 * ft * (1.0 if vt > 0.0 else -1.0)
-        Dx = kn * nx + kt * ex
-        Dy = kn * ny + kt * ey
-        Dz = kn * nz + kt * ez
-        w[F + a] = T * ex + 0.5 * Dx  # force on the lower node, stored at its index below
-        w[F + a + 1] = T * ey + 0.5 * Dy
-        w[F + a + 2] = T * ez + 0.5 * Dz
-        w[WN + a] = -T * ex + 0.5 * Dx  # force on the upper node (wind slot no longer needed)
-        w[WN + a + 1] = -T * ey + 0.5 * Dy
-        w[WN + a + 2] = -T * ez + 0.5 * Dz
-    # scatter: node j gets the lower-node force of element j-1 and the upper-node force of
-    # element j, plus gravity (full node mass inside, half an element at the confluence point)
-    g = m_node * p[P_G]
-    for j in range(n, -1, -1):
-        fx = w[F + 3 * j - 3] if j > 0 else 0.0
-        fy = w[F + 3 * j - 2] if j > 0 else 0.0
-        fz = w[F + 3 * j - 1] if j > 0 else 0.0
+        # f_t(phi) by Estrin's scheme (a reassociated Horner: shorter dependency chain)
+        p2 = phi * phi
+        ft = (t0 + phi * t1) + p2 * ((t2 + phi * t3) + p2 * (t4 + phi * t5))
+        vv[2 * e] = -qd * v2 * fn / vn if vn > 0.0 else 0.0
+        vv[2 * e + 1] = -qd * v2 * ft * (1.0 if vt > 0.0 else -1.0)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _node_forces(x, p, w, n):
+    """Node forces: node j gets T e + D/2 from the element above it (j-1, of which it is the
+    lower node) and -T e + D/2 from the element below (j), plus gravity (full node mass inside,
+    half an element at the confluence point)."""
+    o = 6 * (n - 1)
+    g = p[P_MU] * x[o + 12] / n * p[P_G]
+    frc, ten = w[6 * (n + 1):9 * (n + 1)], w[9 * (n + 1):9 * (n + 1) + n]
+    vn, kk, ev = _element_views(p, w, n)
+    ux = uy = uz = 0.0  # force on node j from element j-1 (none above node 0)
+    for j in range(n + 1):
+        fx, fy, fz = ux, uy, uz
         if j < n:
-            fx += w[WN + 3 * j]
-            fy += w[WN + 3 * j + 1]
-            fz += w[WN + 3 * j + 2]
-        w[F + 3 * j] = fx
-        w[F + 3 * j + 1] = fy
-        w[F + 3 * j + 2] = fz - (0.5 * g if j == 0 else g)
-    return w[T0 + n - 1]
+            a = 3 * j
+            T, kn, kt = ten[j], kk[2 * j], kk[2 * j + 1]
+            ex, ey, ez = ev[a], ev[a + 1], ev[a + 2]
+            Dx = kn * vn[a] + kt * ex
+            Dy = kn * vn[a + 1] + kt * ey
+            Dz = kn * vn[a + 2] + kt * ez
+            fx += -T * ex + 0.5 * Dx
+            fy += -T * ey + 0.5 * Dy
+            fz += -T * ez + 0.5 * Dz
+            ux, uy, uz = T * ex + 0.5 * Dx, T * ey + 0.5 * Dy, T * ez + 0.5 * Dz
+        frc[3 * j] = fx
+        frc[3 * j + 1] = fy
+        frc[3 * j + 2] = fz - (0.5 * g if j == 0 else g)
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -320,17 +386,19 @@ def _hull(u, v, wv, p):
     if V2 < 1e-20:
         return 0.0, 0.0, 0.0, 0.0, 0.0
     V = math.sqrt(V2)
+    iV = 1.0 / V
     q0 = 0.5 * p[P_RHO] * V2
-    ca = u / V
-    sa = math.sqrt(v * v + wv * wv) / V
+    qV = q0 * iV  # q / V
+    ca = u * iV
+    sa = math.sqrt(v * v + wv * wv) * iV
     c2 = math.sqrt(max(0.0, 0.5 * (1.0 + ca)))  # cos(alpha/2)
     s2 = math.sqrt(max(0.0, 0.5 * (1.0 - ca)))  # sin(alpha/2)
     kp = p[P_KPOT]
     # drag along -x: axial friction (sign follows u) minus the axial part of the potential force
     D = q0 * (p[P_CD0H] * p[P_SH] * ca * abs(ca) - kp * p[P_I1] * 2.0 * sa * ca * s2)
     # lift and nose moment per unit crossflow speed (divide sin(alpha) by Vc = V sin(alpha))
-    Lc = q0 / V * (kp * p[P_I1] * 2.0 * ca * c2 + p[P_CDC] * p[P_J1] * sa)
-    Mc = -q0 / V * (kp * p[P_I3] * 2.0 * ca * c2 + p[P_CDC] * p[P_J2] * sa)
+    Lc = qV * (kp * p[P_I1] * 2.0 * ca * c2 + p[P_CDC] * p[P_J1] * sa)
+    Mc = -qV * (kp * p[P_I3] * 2.0 * ca * c2 + p[P_CDC] * p[P_J2] * sa)
     # force components; moment about x_hat x lift_hat = (0, w, -v)/Vc, times M_nose
     return -D, -Lc * v, -Lc * wv, Mc * wv, -Mc * v
 
@@ -356,7 +424,8 @@ def _fin(u, v, wv, p, i):
     if qin > 1e-12:
         # lift perpendicular to the in-plane velocity, against the crossflow:
         # F_L = L (sin(alpha) x_hat - cos(alpha) n_hat)
-        sal, cal = wn / qin, un / qin
+        iq = 1.0 / qin
+        sal, cal = wn * iq, un * iq
         lift = q * cl
         fx += lift * sal - lift * cal * nx
         fy += -lift * cal * ny
@@ -366,7 +435,7 @@ def _fin(u, v, wv, p, i):
     return fx + kd * u, fy + kd * v, fz + kd * wv
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, _nrt=False)
 def rhs(t, x, u, p, wp, wf, dx, w):
     """State derivative dx = f(t, x, u) of the full model (see module docstring).
 
@@ -377,20 +446,28 @@ def rhs(t, x, u, p, wp, wf, dx, w):
     wp, wf : wind parameter vector and turbulence field (:mod:`aerostat_gym.physics.wind`).
     dx : output array, same size as x. w : work array of ``work_size(n)`` floats; on return it
     holds node positions, velocities, forces and element tensions.
+
+    Compiled without reference counting (``_nrt=False``): it only reads and writes the arrays
+    it is given, and the atomic increments cost more than the tether. The aerostat's
+    aerodynamic loads come first: they do not depend on the tether, so the processor works on
+    them while the tether's square roots and divisions are in flight.
     """
     n = int(p[P_NEL])
     nm = n - 1
     o = 6 * nm
     R = _rotation(x[o + 6], x[o + 7], x[o + 8])
-    Tw = tether_forces(t, x, p, wp, wf, R, w)
+    npts = _kinematics(x, p, R, w)
+    wind_batch(t, w, npts, _pts(n), wp, wf)
+    loads = _aero_loads(x, p, w, R, o)
+    Tw = _tether(x, p, w)
     F = 6 * (n + 1)
-    L = x[o + 12]
-    m_node = p[P_MU] * L / n
-    for j in range(nm):
-        for k in range(3):
-            dx[3 * j + k] = x[3 * nm + 3 * j + k]
-            dx[3 * nm + 3 * j + k] = w[F + 3 * (j + 1) + k] / m_node
-    _aerostat(x, p, w, R, w[F], w[F + 1], w[F + 2], dx, o)
+    # moving nodes: position' = velocity, velocity' = force / node mass (views: no wraparound)
+    im_node = n / (p[P_MU] * x[o + 12])
+    xv, dxp, dxv, frc = x[3 * nm:6 * nm], dx[:3 * nm], dx[3 * nm:6 * nm], w[F + 3:F + 3 * n]
+    for i in range(3 * nm):
+        dxp[i] = xv[i]
+        dxv[i] = frc[i] * im_node
+    _aerostat(x, p, R, loads, w[F], w[F + 1], w[F + 2], dx, o)
     if p[P_FIXED] != 0.0:
         for k in range(12):
             dx[o + k] = 0.0
@@ -398,36 +475,29 @@ def rhs(t, x, u, p, wp, wf, dx, w):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def _aerostat(x, p, w, R, flx, fly, flz, dx, o):
-    """Aerostat rigid-body derivatives; (flx, fly, flz) is the tether force at the leash (inertial)
-    and the winds at the hull and fin points are read from the work array."""
+def _aero_loads(x, p, w, R, o):
+    """Body-frame force and moment about the CM of everything on the aerostat except the
+    tether: weight at the CM, buoyancy at the CB, hull and fins (winds at the hull and fin
+    points are read from the work array)."""
     n = int(p[P_NEL])
     nf = int(p[P_NFIN])
-    R00, R01, R02, R10, R11, R12, R20, R21, R22, cph, sph, cth, sth = R
     vx, vy, vz = x[o + 3], x[o + 4], x[o + 5]
     pp, qq, rr = x[o + 9], x[o + 10], x[o + 11]
     # body components of the CM velocity
-    ub = R00 * vx + R10 * vy + R20 * vz
-    vb = R01 * vx + R11 * vy + R21 * vz
-    wb = R02 * vx + R12 * vy + R22 * vz
+    ub = R[0] * vx + R[3] * vy + R[6] * vz
+    vb = R[1] * vx + R[4] * vy + R[7] * vz
+    wb = R[2] * vx + R[5] * vy + R[8] * vz
     g, m, B = p[P_G], p[P_MASS], p[P_BUOY]
     # body components of inertial up (z_hat)
-    zx, zy, zz = R20, R21, R22
-    # gravity at the CM, buoyancy at the CB, tether at the leash point
-    Fx = (B - m * g) * zx + R00 * flx + R10 * fly + R20 * flz
-    Fy = (B - m * g) * zy + R01 * flx + R11 * fly + R21 * flz
-    Fz = (B - m * g) * zz + R02 * flx + R12 * fly + R22 * flz
+    zx, zy, zz = R[6], R[7], R[8]
+    # gravity at the CM, buoyancy at the CB
+    Fx = (B - m * g) * zx
+    Fy = (B - m * g) * zy
+    Fz = (B - m * g) * zz
     xb, yb, zb = p[P_CB], p[P_CB + 1], p[P_CB + 2]
     Mx = yb * B * zz - zb * B * zy
     My = zb * B * zx - xb * B * zz
     Mz = xb * B * zy - yb * B * zx
-    xl, yl, zl = p[P_LEASH], p[P_LEASH + 1], p[P_LEASH + 2]
-    fbx = R00 * flx + R10 * fly + R20 * flz
-    fby = R01 * flx + R11 * fly + R21 * flz
-    fbz = R02 * flx + R12 * fly + R22 * flz
-    Mx += yl * fbz - zl * fby
-    My += zl * fbx - xl * fbz
-    Mz += xl * fby - yl * fbx
     # hull: air-relative velocity at the centre of buoyancy (the hull's volume centroid)
     WA = _pts(n) + 3 * (2 * n + 1 + nf)  # wind at the hull point, then at each fin
     hx, hy, hz = _air_body(ub, vb, wb, pp, qq, rr, xb, yb, zb, R, w[WA], w[WA + 1], w[WA + 2])
@@ -451,6 +521,33 @@ def _aerostat(x, p, w, R, flx, fly, flz, dx, o):
         Mx += cy * ffz - cz * ffy
         My += cz * ffx - cx * ffz
         Mz += cx * ffy - cy * ffx
+    return Fx, Fy, Fz, Mx, My, Mz
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _aerostat(x, p, R, loads, flx, fly, flz, dx, o):
+    """Aerostat rigid-body derivatives from the non-tether loads (body frame, about the CM) and
+    (flx, fly, flz), the tether force at the leash point (inertial)."""
+    R00, R01, R02, R10, R11, R12, R20, R21, R22, cph, sph, cth, sth = R
+    Fx, Fy, Fz, Mx, My, Mz = loads
+    icth = 1.0 / cth
+    vx, vy, vz = x[o + 3], x[o + 4], x[o + 5]
+    pp, qq, rr = x[o + 9], x[o + 10], x[o + 11]
+    # body components of the CM velocity
+    ub = R00 * vx + R10 * vy + R20 * vz
+    vb = R01 * vx + R11 * vy + R21 * vz
+    wb = R02 * vx + R12 * vy + R22 * vz
+    # tether at the leash point
+    xl, yl, zl = p[P_LEASH], p[P_LEASH + 1], p[P_LEASH + 2]
+    fbx = R00 * flx + R10 * fly + R20 * flz
+    fby = R01 * flx + R11 * fly + R21 * flz
+    fbz = R02 * flx + R12 * fly + R22 * flz
+    Fx += fbx
+    Fy += fby
+    Fz += fbz
+    Mx += yl * fbz - zl * fby
+    My += zl * fbx - xl * fbz
+    Mz += xl * fby - yl * fbx
     # Kirchhoff inertial terms: M_e a_B = F + M_a (omega x V) - omega x (M_a V)
     max_, may, maz = p[P_MA], p[P_MA + 1], p[P_MA + 2]
     ox, oy, oz = qq * wb - rr * vb, rr * ub - pp * wb, pp * vb - qq * ub  # omega x V
@@ -479,10 +576,10 @@ def _aerostat(x, p, w, R, flx, fly, flz, dx, o):
     dx[o + 10] = p[J + 3] * Mx + p[J + 4] * My + p[J + 5] * Mz
     dx[o + 11] = p[J + 6] * Mx + p[J + 7] * My + p[J + 8] * Mz
     # Z-Y-X Euler kinematics
-    tth = sth / cth
+    tth = sth * icth
     dx[o + 6] = pp + (qq * sph + rr * cph) * tth
     dx[o + 7] = qq * cph - rr * sph
-    dx[o + 8] = (qq * sph + rr * cph) / cth
+    dx[o + 8] = (qq * sph + rr * cph) * icth
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")

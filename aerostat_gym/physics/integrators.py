@@ -28,6 +28,7 @@ OK, NONFINITE = 0, 1
 RK4_STABILITY = 2.0 * math.sqrt(2.0)  # RK4 stability limit on the imaginary axis, |lambda| h
 
 
+@njit(cache=True)
 def omega_max(EA: float, mu: float, l_u: float, n: int) -> float:
     """Highest axial frequency of the tether's interior chain (n - 1 nodes of mass mu l_u joined
     by springs EA / l_u between two much heavier or fixed ends):
@@ -37,6 +38,7 @@ def omega_max(EA: float, mu: float, l_u: float, n: int) -> float:
     return 2.0 * math.sqrt(EA / mu) / l_u * factor
 
 
+@njit(cache=True)
 def rk4_step(EA: float, mu: float, l_u: float, safety: float, n: int) -> float:
     """Largest stable RK4 step times the safety factor: safety * 2 sqrt(2) / omega_max.
 
@@ -45,7 +47,7 @@ def rk4_step(EA: float, mu: float, l_u: float, safety: float, n: int) -> float:
     return safety * RK4_STABILITY / omega_max(EA, mu, l_u, n)
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _tension_stats(w, n, stats):
     T0 = 9 * (n + 1)
     tmax = 0.0

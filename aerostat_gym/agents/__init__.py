@@ -1,0 +1,1 @@
+"""Baseline controllers (winch LQR) and response metrics for the aerostat environment."""

@@ -1,0 +1,192 @@
+"""``aerostat-gym evaluate``: one evaluator for the baselines and SB3 policies on frozen suites.
+
+Scenarios:
+
+- ``recover``: steady wind (no turbulence), the aerostat and tether swung 10 m along the wind
+  and the aerostat pitched 0.05 rad (fixed, not drawn), 180 s: damping ratios and periods of
+  the longitudinal pendulum and the pitch oscillation identified by fitting damped sinusoids.
+- ``gusty``: moderate turbulence (von Karman, sigma_u = 1.6 m/s), no initial perturbation,
+  120 s: RMS displacement and pitch, tension, winch energy.
+
+Suites fix the wind speeds and seeds (``SUITES``), so a number in a report can be reproduced
+exactly. The suite score is the mean episode return under the environment's default reward.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..envs.spaces import N_OBS
+from ..envs.vector import TetheredAerostatVectorEnv
+from .baselines import PolicyError, load_policy
+from .metrics import response_metrics
+
+RECOVER = {"turbulence": "none",
+           "perturbation": {"swing": 10.0, "pitch": 0.05, "fixed": True}}
+GUSTY = {"turbulence": "moderate", "perturbation": "none"}
+SCENARIOS = {"recover": (RECOVER, 180.0), "gusty": (GUSTY, 120.0)}
+SUITES = {
+    "damping": {"recover": ([5.0, 10.0, 15.0], [0])},  # model selection during training
+    "tiny": {"recover": ([5.0, 10.0, 15.0], [0]), "gusty": ([10.0], [100, 101])},
+    "small": {"recover": ([5.0, 10.0, 15.0], [0]), "gusty": ([5.0, 10.0, 15.0], [100, 101, 102])},
+    "full": {"recover": ([3.0, 5.0, 7.5, 10.0, 12.5, 15.0], [0]),
+             "gusty": ([5.0, 10.0, 15.0], list(range(100, 110)))},
+}
+
+
+@dataclass
+class Episodes:
+    """Time histories of one scenario for one policy (arrays: episode x sample)."""
+
+    scenario: str
+    speeds: np.ndarray
+    seeds: np.ndarray
+    time: np.ndarray
+    x: np.ndarray  # along-wind CM displacement from trim [m]
+    pitch: np.ndarray  # pitch minus trim [rad]
+    tension: np.ndarray  # winch tension [N]
+    reel_speed: np.ndarray  # [m/s]
+    returns: np.ndarray
+    ended: list  # termination reason or None per episode
+
+
+def check_suite(name: str) -> dict:
+    if name not in SUITES:
+        raise ValueError(f"unknown suite {name!r}; choose one of {list(SUITES)}")
+    return SUITES[name]
+
+
+def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2,
+                 env_kwargs: dict | None = None) -> Episodes:
+    """Run ``policy`` on every (speed, seed) pair of a scenario in one batched environment."""
+    kwargs, duration = SCENARIOS[scenario]
+    pairs = [(u, s) for u in speeds for s in seeds]
+    steps = int(round(duration / control_step))
+    env = TetheredAerostatVectorEnv(num_envs=len(pairs), max_episode_steps=steps,
+                                    observation="full", control_step=control_step,
+                                    **{**(env_kwargs or {}), **kwargs})
+    obs, _ = env.reset(seed=[s for _, s in pairs],
+                       options={"wind_speed": [u for u, _ in pairs]})
+    b, lay = env.batch, env.batch.layout
+    ix, ith, iv = lay.cm_pos.start, lay.euler.start + 1, lay.winch_speed
+    rec = {k: np.zeros((len(pairs), steps + 1)) for k in ("x", "pitch", "tension", "reel")}
+    alive = np.ones(len(pairs), bool)
+    ended, returns = [None] * len(pairs), np.zeros(len(pairs))
+    state, start = None, np.ones(len(pairs), bool)
+
+    def record(k):
+        rec["x"][:, k] = np.where(alive, b.X[:, ix] - b.XT[:, ix], np.nan)
+        rec["pitch"][:, k] = np.where(alive, b.X[:, ith] - b.XT[:, ith], np.nan)
+        rec["tension"][:, k] = np.where(alive, obs[:, 12] * 1.0e4, np.nan)
+        rec["reel"][:, k] = np.where(alive, b.X[:, iv], np.nan)
+
+    record(0)
+    for k in range(1, steps + 1):
+        action, state = policy.predict(policy_obs(policy, obs), state=state, episode_start=start,
+                                       deterministic=True)
+        start[:] = False
+        obs, rew, term, trunc, info = env.step(np.asarray(action, np.float32).reshape(-1, 1))
+        returns += np.where(alive, rew, 0.0)
+        for i in np.flatnonzero(term & alive):
+            ended[i] = info["termination"][i]
+        alive &= ~term
+        record(k)
+    env.close()
+    t = np.arange(steps + 1) * control_step
+    return Episodes(scenario, np.array([u for u, _ in pairs]), np.array([s for _, s in pairs]),
+                    t, rec["x"], rec["pitch"], rec["tension"], rec["reel"], returns, ended)
+
+
+def policy_obs(policy, obs: np.ndarray) -> np.ndarray:
+    """The observation slice a policy reads: the standard channels or the privileged full set."""
+    need = getattr(policy, "obs_dim", None)
+    if need is None or need == obs.shape[1]:
+        return obs
+    if need == N_OBS:
+        return obs[:, :N_OBS]
+    raise PolicyError(f"the policy expects observations of {need} channels; the environment "
+                      f"gives {N_OBS} (observation='standard') or {obs.shape[1]} ('full'): it was "
+                      "trained for another observation layout")
+
+
+def episode_metrics(ep: Episodes, i: int) -> dict:
+    m = response_metrics(ep.time, ep.x[i], ep.pitch[i], ep.tension[i], ep.reel_speed[i])
+    m.update({"wind_speed": float(ep.speeds[i]), "seed": int(ep.seeds[i]),
+              "return": float(ep.returns[i]), "ended": ep.ended[i]})
+    return m
+
+
+def evaluate(policy_name: str, suite: str = "tiny", control_step: float = 0.2,
+             params=None) -> dict:
+    """Metrics of one policy on a suite: {scenario: [per-episode metrics]}, plus the score."""
+    spec = check_suite(suite)
+    policy = load_policy(policy_name, params=params, dt=control_step)
+    out, returns = {"policy": policy_name, "suite": suite, "scenarios": {}}, []
+    for scenario, (speeds, seeds) in spec.items():
+        ep = run_scenario(policy, scenario, speeds, seeds, control_step)
+        rows = [episode_metrics(ep, i) for i in range(len(ep.speeds))]
+        if hasattr(policy, "predicted_modes"):
+            for r in rows:
+                r["predicted"] = policy.predicted_modes(r["wind_speed"])
+        out["scenarios"][scenario] = {"episodes": rows, "histories": ep}
+        returns.extend(ep.returns.tolist())
+    out["score"] = float(np.mean(returns))
+    return out
+
+
+def suite_score(policy, suite: str = "tiny", control_step: float = 0.2) -> float:
+    """Mean episode return of a policy object on a suite (the training curve's measure)."""
+    returns = []
+    for scenario, (speeds, seeds) in check_suite(suite).items():
+        returns.extend(run_scenario(policy, scenario, speeds, seeds, control_step).returns)
+    return float(np.mean(returns))
+
+
+# --- during training -------------------------------------------------------------------------
+
+def _callback_base():
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    return BaseCallback
+
+
+class SuiteEvalCallback(_callback_base()):
+    """Every ``freq`` calls: score the current policy on the fixed suite (deterministic actions,
+    the training VecNormalize statistics), log it, append it to ``evaluations.json`` and save
+    the best model (with its statistics) as ``best_model.zip``."""
+
+    def __init__(self, suite: str, env_kwargs: dict, freq: int, run: Path, algo: str):
+        super().__init__(verbose=0)
+        check_suite(suite)
+        self.suite, self.freq, self.run, self.algo = suite, freq, Path(run), algo
+        self.best = -np.inf
+        self.history = []
+        self.t0 = time.perf_counter()
+
+    def _on_step(self) -> bool:
+        if self.n_calls % self.freq == 0:
+            self.evaluate_now()
+        return True
+
+    def _on_training_end(self) -> None:
+        if not self.history or self.history[-1]["timesteps"] != self.num_timesteps:
+            self.evaluate_now()
+
+    def evaluate_now(self) -> None:
+        from .baselines import SB3Policy
+        from .train import save_model
+
+        policy = SB3Policy(self.model, self.model.get_env())
+        score = suite_score(policy, self.suite)
+        self.logger.record("eval/suite_score", score)
+        self.history.append({"timesteps": int(self.num_timesteps), "score": score,
+                             "wall_time_s": time.perf_counter() - self.t0})
+        (self.run / "evaluations.json").write_text(json.dumps(self.history, indent=1))
+        if score > self.best:
+            self.best = score
+            save_model(self.model, self.run / "best_model.zip")

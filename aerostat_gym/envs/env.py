@@ -1,0 +1,235 @@
+"""``TetheredAerostat-v0``: the single Gymnasium environment (a thin adapter over
+:class:`aerostat_gym.envs.batch.EnvBatch` with one slot)."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+
+from . import spaces
+from .batch import ActionError, EnvBatch
+from .task import TaskConfig
+
+RENDER_MODES = ["human", "rgb_array"]
+
+
+class TetheredAerostatEnv(gym.Env):
+    """
+    ## Description
+
+    A streamlined aerostat (Aeros Flightcam class, 250 m^3) flies on a 300 m viscoelastic
+    tether from a ground winch, after Lambert and Nahon, "Stability Analysis of a Tethered
+    Aerostat" (AIAA 2002-4497): a lumped-mass tether of n elements (Morison drag, gravity,
+    tension-only viscoelastic elements) joined at the confluence point to a rigid 6-DOF
+    aerostat modelled by component breakdown, in a mean wind with turbulence. The task is to
+    damp the aerostat's pendulum (blow-by) and pitch oscillations with the winch alone.
+
+    Frames and signs: inertial X, Y, Z with Z up and the winch at the origin; the mean wind
+    blows along +X, so at trim the aerostat flies downwind (X > 0) with its nose into the wind
+    (yaw psi = pi). Attitude is the Z-Y-X Euler triple (roll phi, pitch theta positive nose
+    up, yaw psi); body rates p, q, r about the body x (nose), y, z axes. A positive reel speed
+    pays line out. SI units throughout.
+
+    ## Action Space
+
+    ``Box(-1, 1, (1,), float32)``: the winch reel-speed set-point as a fraction of the winch's
+    maximum speed (``winch.max_speed``, 1 m/s by default); positive pays out. The winch's
+    speed loop (time constant, acceleration and motor-force limits) follows the set-point;
+    set-points below ``winch.brake_speed`` engage the brake, which clamps the drum once it has
+    slowed down (so action 0 is the passive, braked winch). Out-of-range actions are clipped
+    to [-1, 1] (counted in ``info["action_clipped"]``); a NaN or infinite action raises
+    :class:`aerostat_gym.envs.ActionError` naming the value.
+
+    ## Observation Space
+
+    ``Box(low, high, (19,), float32)`` with ``observation="standard"``: each channel is a
+    physical quantity divided by its scale, clipped to finite bounds
+    (:func:`aerostat_gym.envs.observation_table` prints the table):
+
+    | index | quantity | unit | scale |
+    |---|---|---|---|
+    | 0-2 | aerostat CM position minus the episode's trim (X, Y, Z) | m | 10 |
+    | 3-5 | aerostat CM velocity (X, Y, Z) | m/s | 2 |
+    | 6-8 | roll, pitch, yaw minus trim (yaw wrapped to [-pi, pi]) | rad | 0.05 |
+    | 9-11 | body rates p, q, r | rad/s | 0.02 |
+    | 12 | winch tension (load cell) | N | 1e4 |
+    | 13 | winch tension minus its trim value | N | 1e3 |
+    | 14 | tether length minus trim | m | 10 |
+    | 15 | reel speed | m/s | 1 |
+    | 16-18 | measured air velocity at the aerostat CM (X, Y, Z) | m/s | 10 |
+
+    ``obs_noise`` adds Gaussian noise of that standard deviation (in scaled units) to these
+    channels. ``observation="full"`` appends, unscaled and privileged, the episode's mean
+    wind speed [m/s] and the full simulator state minus trim (6 n + 8 entries in
+    :class:`aerostat_gym.physics.layout.StateLayout` order; 68 for n = 10): 88 channels.
+
+    ## Rewards
+
+    The reward is the sum of named non-positive terms, each in ``info["reward_<name>"]``
+    (so ``reward == sum`` of them to float precision), with weights from ``reward_weights``:
+    displacement ``-w (dx^2+dy^2)`` and velocity ``-w (vx^2+vy^2)`` in the scaled channels
+    above (horizontal: the blow-by swing; the winch's own reeling moves the aerostat vertically); pitch ``-w dpitch^2``; pitch_rate ``-w q^2``; effort ``-w a^2``;
+    effort_rate ``-w (a - a_prev)^2``; over_tension ``-w max(0, T_peak / SWL - 1)`` with the
+    peak element tension over the step and the winch's safe working load; termination ``-w``
+    on a terminating step; length ``-w dlength^2`` (channel 14), which keeps the winch near its
+    trim length on average. Defaults: ``aerostat_gym.envs.DEFAULT_WEIGHTS``.
+
+    ## Starting State
+
+    The exact trim (equilibrium) for a mean wind speed drawn uniformly on the 0.1 m/s grid of
+    ``wind_speed`` (default 3 to 15 m/s), then perturbed (``perturbation``, default
+    ``"mixed"``): aerostat and tether swung rigidly about the winch by up to 10 m along the
+    wind and 5 m across it (no element stretched), the aerostat pitched about its confluence
+    point by up to 0.05 rad, and with probability 0.5 a 1 - cos gust along the wind (1-4 m/s,
+    5-20 s, onset within 30 s). Turbulence (default ``"moderate"``, sigma_u = 1.6 m/s von
+    Karman) is a frozen coherent field from a bank generated once per process from
+    ``wind_bank_seed``; each episode reads a random bank field from a random along-wind offset.
+    ``reset(options={"wind_speed": U, "perturbation": ...})`` fixes them for one episode.
+
+    ## Episode End
+
+    Terminated on tether break (an element above the tether strength), ground strike (the
+    aerostat CM below one hull diameter), tether length outside the winch's limits, or
+    numerical failure (``info["failure"] = "nonfinite_state"``: the observation is that of the
+    last finite state; no exception). ``info["termination"]`` names the reason. Truncated by
+    the time limit set at registration (600 steps = 120 s at the default 0.2 s control step).
+
+    ## Arguments
+
+    ``gym.make("TetheredAerostat-v0", **kwargs)`` with:
+
+    - ``wind_speed=(3.0, 15.0)``: range of the episode's mean wind speed [m/s].
+    - ``turbulence="moderate"``: preset ("none", "light", "moderate", "severe") or a dict of
+      :class:`aerostat_gym.wind.TurbulenceConfig` fields (key "preset" picks the base).
+    - ``perturbation="mixed"``: "none", "displacement", "gust", "mixed" or a dict with keys
+      swing [m], lateral [m], pitch [rad], gust_probability, gust_amplitude [m/s] (low, high),
+      gust_duration [s] (low, high), gust_onset [s] (low, high).
+    - ``tether_length=None`` [m] and ``n_elements=None``: override the parameter file.
+    - ``integrator="semi-implicit"`` or ``"rk4"`` (the reference; about 7x slower).
+    - ``control_step=0.2`` [s]: 220 steps per pendulum period (~44 s), ~15 per axial-spring
+      period (2.9 s), while the winch's 0.3 s speed loop and 0.5 m/s^2 acceleration limit make
+      faster commands pointless; 600 steps per 120 s episode keep the credit-assignment horizon
+      of RL within reach (gamma = 0.99 looks ~20 s ahead). The episode length in steps is the
+      registration's ``max_episode_steps``: pass ``max_episode_steps`` to ``gym.make`` with a
+      different control step.
+    - ``params=None``: a :class:`aerostat_gym.params.Params` or a TOML path (default: the
+      shipped baseline); ``overrides``: {"section.key": value}.
+    - ``randomize=None``: domain randomisation, {"section.key": relative half-range} or True for
+      the estimated parameters in ``aerostat_gym.envs.task.DEFAULT_RANDOMIZATION``; each
+      episode re-trims for its drawn parameters (a few ms per reset).
+    - ``obs_noise=0.0``: sensor noise std in scaled units. ``reward_weights=None``: dict of
+      weights by term name. ``observation="standard"`` or ``"full"``.
+    - ``wind_bank_size=8``, ``wind_bank_seed=0``: the shared turbulence bank.
+    - ``render_mode=None``: "rgb_array" (an (480, 800, 3) frame: side view x-z with the tether,
+      hull, fins, wind arrow and tension readout, plus a top view x-y) or "human".
+
+    ## Version History
+
+    - v0: initial release (aerostat-gym 0.1).
+    """
+
+    metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
+
+    def __init__(self, render_mode: str | None = None, **kwargs):
+        if render_mode is not None and render_mode not in RENDER_MODES:
+            raise ValueError(f"unknown render_mode {render_mode!r}; choose one of {RENDER_MODES}")
+        self.render_mode = render_mode
+        self.task = TaskConfig(**kwargs)
+        self._batch = EnvBatch(self.task, 1)
+        b = self._batch
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
+        self.observation_space = gym.spaces.Box(b.obs_low, b.obs_high, dtype=np.float32)
+        self.metadata = {**self.metadata, "render_fps": round(1.0 / self.task.control_step)}
+        self._renderer = None
+        self._steps = 0
+
+    # --- Gymnasium API ---------------------------------------------------------------------
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        self._sync_horizon()
+        info = self._batch.reset_one(0, self.np_random, options)
+        self._batch.add_noise(0, self.np_random)
+        self._steps = 0
+        if self.render_mode == "human":
+            self.render()
+        return self._batch.OBS[0].copy(), info
+
+    def step(self, action):
+        b = self._batch
+        a = np.asarray(action, dtype=float).reshape(-1)
+        if a.shape != (1,):
+            raise ActionError(f"action must have shape (1,), got {np.shape(action)}")
+        v = a[0]
+        if not math.isfinite(v):
+            raise ActionError(f"action must be finite, got {v!r}")
+        b.A[0] = min(max(v, -1.0), 1.0)
+        b.step()
+        b.add_noise(0, self.np_random)
+        self._steps += 1
+        terms = b.TERMS[0]
+        code = int(b.CODE[0])
+        info = {"reward_" + k: terms[j] for j, k in enumerate(spaces.REWARD_TERMS)}
+        info["action_clipped"] = bool(abs(v) > 1.0)
+        info["time"] = b.T[0]
+        terminated = truncated = False
+        if code != spaces.RUNNING:
+            reason = spaces.OUTCOMES[code]
+            if code == spaces.FIELD_END:
+                truncated = True
+                info["truncation"] = reason
+            else:
+                terminated = True
+                info["termination"] = reason
+                if code == spaces.NONFINITE:
+                    info["failure"] = reason
+        if self.render_mode == "human":
+            self.render()
+        return b.OBS[0].copy(), float(terms.sum()), terminated, truncated, info
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode="
+                            "'rgb_array' or 'human' to gym.make")
+            return None
+        from .render import Frame, Renderer
+
+        if self._renderer is None:
+            self._renderer = Renderer(self._batch.params, self.render_mode,
+                                      fps=self.metadata["render_fps"])
+        s = self._batch.snapshot(0)
+        wind = np.array([s["wind_speed"], 0.0, 0.0])
+        frame = Frame(time=s["time"], nodes=s["nodes"], cm_pos=s["cm_pos"], euler=s["euler"],
+                      wind=wind, tension=s["tension"], length=s["length"],
+                      reel_speed=s["reel_speed"], trim_cm=s["trim_cm"])
+        return self._renderer.render(frame)
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    # --- helpers ---------------------------------------------------------------------------
+
+    @property
+    def state(self) -> np.ndarray:
+        """The full simulator state (copy; StateLayout order)."""
+        return self._batch.X[0].copy()
+
+    @property
+    def episode(self):
+        """The current episode's start (trim, parameters, wind speed, perturbation)."""
+        return self._batch.episodes[0]
+
+    def _sync_horizon(self) -> None:
+        """Size the turbulence coverage to the registered episode length once it is known."""
+        steps = getattr(self.spec, "max_episode_steps", None) if self.spec else None
+        if steps and abs(steps * self.task.control_step - self._batch.horizon) > 1e-9:
+            self._batch = EnvBatch(self.task, 1, steps * self.task.control_step)
+
+    def __getstate__(self):
+        d = dict(self.__dict__)
+        d["_renderer"] = None
+        return d

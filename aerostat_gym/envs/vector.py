@@ -1,0 +1,267 @@
+"""Native batched environments: N episodes stepped by one compiled call, parallel over
+environments (numba ``prange``; ``NUMBA_NUM_THREADS`` sets the threads).
+
+- :class:`TetheredAerostatVectorEnv`: a ``gymnasium.vector.VectorEnv``, what
+  ``gym.make_vec("TetheredAerostat-v0", num_envs=N, vectorization_mode="vector_entry_point")``
+  returns; Gymnasium's autoreset semantics (``NEXT_STEP`` by default, ``SAME_STEP`` on request).
+- :class:`SB3VecEnv`: the same batch as a Stable-Baselines3 ``VecEnv`` (same-step reset with
+  ``info["terminal_observation"]``), so training needs no subprocesses.
+
+Environment i is seeded with ``seed + i`` and then equals a single ``TetheredAerostat-v0``
+reset with that seed, step for step.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from . import spaces
+from .batch import EnvBatch
+from .env import TetheredAerostatEnv
+from .task import TaskConfig
+
+DEFAULT_MAX_EPISODE_STEPS = 600
+
+
+class TetheredAerostatVectorEnv(VectorEnv):
+    """``num_envs`` copies of :class:`TetheredAerostatEnv` (same arguments, see its docstring)
+    stepped together; ``max_episode_steps`` truncates each episode (600 by default)."""
+
+    metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
+                 autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+                 render_mode: str | None = None, **kwargs):
+        if not (isinstance(num_envs, int) and num_envs >= 1):
+            raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
+        self.autoreset_mode = AutoresetMode(autoreset_mode)
+        if self.autoreset_mode == AutoresetMode.DISABLED:
+            raise ValueError("autoreset_mode DISABLED is not supported; use NEXT_STEP or "
+                             "SAME_STEP")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"unknown render_mode {render_mode!r}; the vector env renders "
+                             "'rgb_array' (environment 0)")
+        self.render_mode = render_mode
+        self.metadata = {**self.metadata, "autoreset_mode": self.autoreset_mode}
+        self.task = TaskConfig(**kwargs)
+        self.max_episode_steps = int(max_episode_steps or DEFAULT_MAX_EPISODE_STEPS)
+        self.num_envs = num_envs
+        self.batch = EnvBatch(self.task, num_envs, self.max_episode_steps * self.task.control_step)
+        b = self.batch
+        self.single_action_space = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
+        self.single_observation_space = gym.spaces.Box(b.obs_low, b.obs_high, dtype=np.float32)
+        self.action_space = batch_space(self.single_action_space, num_envs)
+        self.observation_space = batch_space(self.single_observation_space, num_envs)
+        self._rngs = [seeding.np_random(None)[0] for _ in range(num_envs)]
+        self._steps = np.zeros(num_envs, dtype=np.int64)
+        self._pending = np.zeros(num_envs, dtype=np.bool_)  # NEXT_STEP: reset at the next step
+        self._renderer = None
+
+    # --- Gymnasium VectorEnv API -----------------------------------------------------------
+
+    def reset(self, *, seed=None, options=None):
+        opts = dict(options or {})
+        mask = opts.pop("reset_mask", None)
+        mask = np.ones(self.num_envs, bool) if mask is None else np.asarray(mask, bool)
+        seeds = _seeds(seed, self.num_envs)
+        infos = []
+        for i in np.flatnonzero(mask):
+            if seeds[i] is not None or self._rngs[i] is None:
+                self._rngs[i] = seeding.np_random(seeds[i])[0]
+            infos.append((i, self._reset(i, _options_for(opts, i, self.num_envs))))
+            self._pending[i] = False
+        return self.batch.OBS.copy(), _stack_infos(infos, self.num_envs)
+
+    def step(self, actions):
+        b = self.batch
+        b.set_actions(actions)
+        pending = self._pending.copy()
+        clipped = np.abs(np.asarray(actions, float).reshape(self.num_envs)) > 1.0
+        b.step(~pending)
+        self._steps[~pending] += 1
+        rewards = b.TERMS.sum(axis=1)
+        code = b.CODE
+        terminated = (code != spaces.RUNNING) & (code != spaces.FIELD_END) & ~pending
+        truncated = ((code == spaces.FIELD_END) | (self._steps >= self.max_episode_steps)) \
+            & ~pending & ~terminated
+        info = self._step_info(clipped, pending, terminated, truncated)
+        done = terminated | truncated
+        if pending.any():  # NEXT_STEP: these slots start their new episode now
+            resets = [(i, self._reset(i, {})) for i in np.flatnonzero(pending)]
+            rewards[pending] = 0.0
+            info.update(_stack_infos(resets, self.num_envs, prefix="reset_"))
+        for i in np.flatnonzero(~pending):
+            self._noise(i)
+        if self.autoreset_mode == AutoresetMode.NEXT_STEP:
+            self._pending = done.copy()
+        elif done.any():
+            info["final_obs"] = np.array([b.OBS[i].copy() if d else None
+                                          for i, d in enumerate(done)], dtype=object)
+            info["_final_obs"] = done.copy()
+            resets = [(i, self._reset(i, {})) for i in np.flatnonzero(done)]
+            info.update(_stack_infos(resets, self.num_envs, prefix="reset_"))
+        return b.OBS.copy(), rewards, terminated, truncated, info
+
+    def render(self):
+        if self.render_mode is None:
+            return None
+        if self._renderer is None:
+            self._renderer = TetheredAerostatEnv.__new__(TetheredAerostatEnv)
+            self._renderer.render_mode = "rgb_array"
+            self._renderer._renderer = None
+            self._renderer.metadata = {"render_fps": round(1.0 / self.task.control_step)}
+        self._renderer._batch = self.batch  # renders slot 0
+        return self._renderer.render()
+
+    def close_extras(self, **kwargs):
+        if self._renderer is not None:
+            self._renderer.close()
+
+    # --- helpers ---------------------------------------------------------------------------
+
+    def _reset(self, i: int, options: dict) -> dict:
+        info = self.batch.reset_one(i, self._rngs[i], options)
+        self._noise(i)
+        self._steps[i] = 0
+        return info
+
+    def _noise(self, i: int) -> None:
+        if self.task.obs_noise > 0.0:
+            self.batch.add_noise(i, self._rngs[i])
+
+    def _step_info(self, clipped, pending, terminated, truncated) -> dict:
+        b = self.batch
+        stepped = ~pending
+        info = {}
+        for j, k in enumerate(spaces.REWARD_TERMS):
+            info["reward_" + k] = np.where(stepped, b.TERMS[:, j], 0.0)
+            info["_reward_" + k] = stepped
+        info["action_clipped"], info["_action_clipped"] = clipped & stepped, stepped
+        ended = terminated | truncated
+        if ended.any():
+            key = {True: "termination", False: "truncation"}
+            for i in np.flatnonzero(ended):
+                name = key[bool(terminated[i])]
+                code = int(b.CODE[i])
+                reason = spaces.OUTCOMES.get(code, "time_limit")
+                _put(info, name, i, reason, self.num_envs)
+                if code == spaces.NONFINITE:
+                    _put(info, "failure", i, reason, self.num_envs)
+        return info
+
+    def __getstate__(self):
+        d = dict(self.__dict__)
+        d["_renderer"] = None
+        return d
+
+
+def _seeds(seed, n):
+    if seed is None:
+        return [None] * n
+    if isinstance(seed, (int, np.integer)):
+        return [int(seed) + i for i in range(n)]
+    seeds = list(seed)
+    if len(seeds) != n:
+        raise ValueError(f"expected {n} seeds, got {len(seeds)}")
+    return seeds
+
+
+def _options_for(options: dict, i: int, n: int) -> dict:
+    """Reset options of environment i: a list or array of length num_envs gives one value per
+    environment (e.g. ``{"wind_speed": [5, 10, 15]}``); anything else is shared."""
+    return {k: (v[i] if isinstance(v, (list, tuple, np.ndarray)) and len(v) == n else v)
+            for k, v in options.items()}
+
+
+def _put(info, key, i, value, n):
+    if key not in info:
+        info[key] = np.array([None] * n, dtype=object)
+        info["_" + key] = np.zeros(n, dtype=bool)
+    info[key][i] = value
+    info["_" + key][i] = True
+
+
+def _stack_infos(pairs, n, prefix=""):
+    """Gymnasium's vector info layout: per key an array over environments and a mask."""
+    out = {}
+    for i, d in pairs:
+        for k, v in d.items():
+            key = prefix + k
+            if key not in out:
+                numeric = isinstance(v, (int, float, np.floating)) and not isinstance(v, bool)
+                out[key] = np.zeros(n) if numeric else np.array([None] * n, dtype=object)
+                out["_" + key] = np.zeros(n, dtype=bool)
+            out[key][i] = v
+            out["_" + key][i] = True
+    return out
+
+
+def make_vec(num_envs: int = 1, **kwargs) -> TetheredAerostatVectorEnv:
+    """The vector entry point registered for ``TetheredAerostat-v0``."""
+    return TetheredAerostatVectorEnv(num_envs=num_envs, **kwargs)
+
+
+# --- Stable-Baselines3 -----------------------------------------------------------------------
+
+
+def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
+    """A Stable-Baselines3 ``VecEnv`` over one compiled batch of ``num_envs`` environments."""
+    from stable_baselines3.common.vec_env import VecEnv
+
+    class SB3VecEnv(VecEnv):
+        """SB3 adapter: same-step autoreset, ``terminal_observation`` and
+        ``TimeLimit.truncated`` in the per-environment infos."""
+
+        def __init__(self):
+            self.venv = TetheredAerostatVectorEnv(num_envs, autoreset_mode="SameStep", **kwargs)
+            self.render_mode = None
+            super().__init__(num_envs, self.venv.single_observation_space,
+                             self.venv.single_action_space)
+            self._actions = None
+            if seed is not None:
+                self.seed(seed)
+
+        def reset(self):
+            seeds = self._seeds if any(s is not None for s in self._seeds) else None
+            obs, info = self.venv.reset(seed=seeds)
+            self._seeds = [None] * self.num_envs
+            self.reset_infos = [{} for _ in range(self.num_envs)]
+            return obs
+
+        def step_async(self, actions):
+            self._actions = actions
+
+        def step_wait(self):
+            obs, rew, term, trunc, info = self.venv.step(self._actions)
+            dones = term | trunc
+            infos = [{} for _ in range(self.num_envs)]
+            if dones.any():
+                for i in np.flatnonzero(dones):
+                    infos[i]["terminal_observation"] = info["final_obs"][i]
+                    infos[i]["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
+                    for key in ("termination", "failure", "truncation"):
+                        if info.get("_" + key, np.zeros(1, bool))[i] if key in info else False:
+                            infos[i][key] = info[key][i]
+            return obs, rew.astype(np.float32), dones, infos
+
+        def close(self):
+            self.venv.close()
+
+        def get_attr(self, attr_name, indices=None):
+            return [getattr(self.venv, attr_name, None) for _ in self._get_indices(indices)]
+
+        def set_attr(self, attr_name, value, indices=None):
+            setattr(self.venv, attr_name, value)
+
+        def env_method(self, method_name, *args, indices=None, **kw):
+            return [getattr(self.venv, method_name)(*args, **kw)
+                    for _ in self._get_indices(indices)]
+
+        def env_is_wrapped(self, wrapper_class, indices=None):
+            return [False for _ in self._get_indices(indices)]
+
+    return SB3VecEnv()

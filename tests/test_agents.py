@@ -1,0 +1,107 @@
+"""Winch-control agents: baselines, evaluator, training smoke test, policy loading errors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from aerostat_gym.agents.baselines import (
+    PassivePolicy,
+    PolicyError,
+    TensionFeedbackPolicy,
+    load_policy,
+)
+from aerostat_gym.agents.evaluate import run_scenario
+from aerostat_gym.agents.train import train
+from aerostat_gym.cli import main
+from aerostat_gym.envs.spaces import N_OBS
+
+
+def test_baselines_have_sb3_predict_signature():
+    obs = np.zeros((3, N_OBS), np.float32)
+    obs[:, 13] = 2.0  # tension 2 kN above trim
+    for pol in (PassivePolicy(), TensionFeedbackPolicy()):
+        a, state = pol.predict(obs, state=None, episode_start=np.ones(3, bool),
+                               deterministic=True)
+        assert a.shape == (3, 1) and a.dtype == np.float32 and state is None
+        a1, _ = pol.predict(obs[0])
+        assert a1.shape == (1,)
+    a, _ = TensionFeedbackPolicy(gain=0.3).predict(obs)
+    assert np.allclose(a, 0.6)  # 0.3 m/s per kN x 2 kN = 0.6 m/s of a 1 m/s winch
+
+
+def test_passive_recovery_damping_matches_linear_model():
+    """Braked winch at 10 m/s after a 10 m swing: the identified pendulum damping ratio and
+    period agree with the braked linear model (zeta 0.275, T 41.7 s) within 10 % / 3 %."""
+    from aerostat_gym.agents.metrics import fit_damped_sinusoid
+
+    ep = run_scenario(PassivePolicy(), "recover", [10.0], [0])
+    fit = fit_damped_sinusoid(ep.time, ep.x[0])
+    assert abs(fit.zeta - 0.275) / 0.275 < 0.10, fit
+    assert abs(fit.period - 41.7) / 41.7 < 0.03, fit
+
+
+def test_training_smoke_is_deterministic(tmp_path):
+    """A seeded 4,096-step PPO run twice gives identical weights and evaluation scores."""
+    import torch
+    from stable_baselines3 import PPO
+
+    runs = []
+    for k in range(2):
+        run = train("ppo", timesteps=4096, n_envs=8, seed=7, run_dir=tmp_path / f"r{k}",
+                    progress_bar=False, threads=1, eval_freq=10**9)
+        runs.append(run)
+    a = PPO.load(runs[0] / "ppo_final.zip").policy.state_dict()
+    b = PPO.load(runs[1] / "ppo_final.zip").policy.state_dict()
+    assert all(torch.equal(a[k], b[k]) for k in a)
+    for name in ("params.toml", "hyperparams.yml", "command.txt", "version.json",
+                 "evaluations.json", "best_model.zip", "ppo_final_vecnormalize.pkl"):
+        assert (runs[0] / name).is_file(), name
+    ev = [json.loads((r / "evaluations.json").read_text())[-1]["score"] for r in runs]
+    assert ev[0] == ev[1]
+
+
+def test_policy_errors_are_clear(tmp_path, capsys):
+    with pytest.raises(PolicyError, match="not found"):
+        load_policy(str(tmp_path / "missing.zip"))
+    bad = tmp_path / "corrupt.zip"
+    bad.write_bytes(b"not a zip at all")
+    with pytest.raises(PolicyError, match="corrupt"):
+        load_policy(str(bad))
+    with pytest.raises(PolicyError, match="unknown policy"):
+        load_policy("telepathy")
+    assert main(["evaluate", "--policy", str(bad), "--suite", "tiny"]) == 2
+    assert "corrupt" in capsys.readouterr().err
+
+
+def test_policy_for_another_observation_layout_is_rejected(tmp_path):
+    import gymnasium as gym
+    from stable_baselines3 import PPO
+
+    from aerostat_gym.agents.baselines import SB3Policy
+    from aerostat_gym.agents.evaluate import policy_obs
+
+    class Other(gym.Env):
+        observation_space = gym.spaces.Box(-1, 1, (7,), np.float32)
+        action_space = gym.spaces.Box(-1, 1, (1,), np.float32)
+
+    model = PPO("MlpPolicy", Other(), n_steps=8, batch_size=8)
+    path = tmp_path / "other.zip"
+    model.save(path)
+    with pytest.raises(PolicyError, match="observation"):
+        pol = load_policy(str(path))
+        policy_obs(pol if isinstance(pol, SB3Policy) else None, np.zeros((1, N_OBS + 69)))
+
+
+@pytest.mark.slow
+def test_full_training_reaches_shipped_score(tmp_path):
+    """Training from scratch with the shipped configuration reaches the shipped policy's suite
+    score within 10 % (the README states the time it took)."""
+    from aerostat_gym.agents.evaluate import suite_score
+
+    run = train("ppo", seed=0, run_dir=tmp_path / "full", progress_bar=False)
+    shipped = suite_score(load_policy("agents/ppo_tethered_aerostat.zip"), "damping")
+    best = max(e["score"] for e in json.loads((run / "evaluations.json").read_text()))
+    assert best >= shipped - 0.1 * abs(shipped)

@@ -1,0 +1,236 @@
+"""TetheredAerostat-v0: API conformance, determinism, episode ends, batching.
+
+Physics checks assert numbers against references with the tolerance stated; API checks use
+Gymnasium's and Stable-Baselines3's own checkers.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import pickle
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import aerostat_gym  # noqa: F401  (registers the environment)
+from aerostat_gym.envs import (
+    REWARD_TERMS,
+    ActionError,
+    TaskError,
+    TetheredAerostatEnv,
+    observation_table,
+    sb3_vec_env,
+)
+from aerostat_gym.envs.spaces import N_OBS
+from aerostat_gym.physics.layout import StateLayout
+
+ENV_ID = "TetheredAerostat-v0"
+
+
+def _rollout(env, seed, actions):
+    obs, _ = env.reset(seed=seed)
+    out = [obs]
+    for a in actions:
+        obs, *_ = env.step(a)
+        out.append(obs)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "semi-implicit"])
+def test_gymnasium_check_env_no_warnings(integrator):
+    from gymnasium.utils.env_checker import check_env
+
+    env = gym.make(ENV_ID, integrator=integrator)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped, skip_render_check=True)
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "semi-implicit"])
+def test_sb3_check_env_no_warnings(integrator):
+    from stable_baselines3.common.env_checker import check_env
+
+    env = TetheredAerostatEnv(integrator=integrator)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env, warn=True)
+
+
+def test_make_without_prior_import_and_time_limit():
+    env = gym.make("aerostat_gym:TetheredAerostat-v0")
+    assert env.spec.max_episode_steps == 600
+    assert env.observation_space.shape == (N_OBS,)
+    assert env.observation_space.dtype == np.float32
+    assert np.all(np.isfinite(env.observation_space.low))
+    assert np.all(np.isfinite(env.observation_space.high))
+    assert len(observation_table()) == N_OBS
+
+
+def test_same_seed_bit_identical_with_turbulence():
+    """Two environments, same seed, same actions, moderate turbulence: identical bits."""
+    rng = np.random.default_rng(0)
+    actions = rng.uniform(-1, 1, (60, 1)).astype(np.float32)
+    a = _rollout(gym.make(ENV_ID, turbulence="moderate"), 123, actions)
+    b = _rollout(gym.make(ENV_ID, turbulence="moderate"), 123, actions)
+    c = _rollout(gym.make(ENV_ID, turbulence="moderate"), 124, actions)
+    assert np.array_equal(a, b)
+    assert not np.array_equal(a, c)
+
+
+def test_pickle_and_deepcopy_continue_identically():
+    env = gym.make(ENV_ID)
+    env.reset(seed=5)
+    for _ in range(5):
+        env.step(np.array([0.5], np.float32))
+    clones = [pickle.loads(pickle.dumps(env)), copy.deepcopy(env)]
+    ref = [env.step(np.array([-0.3], np.float32))[0] for _ in range(5)]
+    for c in clones:
+        got = [c.step(np.array([-0.3], np.float32))[0] for _ in range(5)]
+        assert np.array_equal(np.array(ref), np.array(got))
+
+
+def test_reward_is_sum_of_named_terms():
+    env = gym.make(ENV_ID)
+    env.reset(seed=3)
+    for k in range(20):
+        _, r, _, _, info = env.step(np.array([math.sin(k / 3.0)], np.float32))
+        terms = [info["reward_" + t] for t in REWARD_TERMS]
+        assert all(t <= 0.0 for t in terms)
+        assert abs(r - sum(terms)) <= 1e-12 * max(1.0, abs(r))  # float precision
+
+
+def test_nan_action_is_a_clear_error_and_out_of_range_is_clipped():
+    env = gym.make(ENV_ID)
+    env.reset(seed=0)
+    with pytest.raises(ActionError, match="finite"):
+        env.step(np.array([np.nan], np.float32))
+    with pytest.raises(ActionError, match="shape"):
+        env.unwrapped.step(np.array([0.1, 0.2]))
+    env2 = gym.make(ENV_ID)
+    env2.reset(seed=0)
+    env.reset(seed=0)
+    o1, *_, info = env.unwrapped.step(np.array([7.0]))
+    o2, *_ = env2.unwrapped.step(np.array([1.0]))
+    assert info["action_clipped"] and np.array_equal(o1, o2)
+
+
+def test_invalid_arguments_name_the_problem():
+    with pytest.raises(TaskError, match="integrator"):
+        TetheredAerostatEnv(integrator="euler")
+    with pytest.raises(TaskError, match="turbulence"):
+        TetheredAerostatEnv(turbulence="hurricane")
+    with pytest.raises(TaskError, match="wind_speed"):
+        TetheredAerostatEnv(wind_speed=(10.0, 5.0))
+    with pytest.raises(TaskError, match="reward weight"):
+        TetheredAerostatEnv(reward_weights={"comfort": 1.0})
+    with pytest.raises(TaskError, match="unknown perturbation"):
+        TetheredAerostatEnv(perturbation="earthquake")
+    with pytest.raises(ValueError, match="render_mode"):
+        TetheredAerostatEnv(render_mode="ascii")
+
+
+def test_reset_starts_at_exact_trim_without_perturbation():
+    """perturbation='none', no turbulence: the start is an equilibrium, so after 10 s with the
+    brake on the aerostat has moved < 1e-3 m (trim residual 1e-9 relative)."""
+    env = gym.make(ENV_ID, turbulence="none", perturbation="none")
+    obs, info = env.reset(seed=0, options={"wind_speed": 10.0})
+    assert info["wind_speed"] == 10.0
+    assert np.max(np.abs(obs[:12])) == 0.0
+    for _ in range(50):
+        obs, *_ = env.step(np.array([0.0], np.float32))
+    assert np.max(np.abs(obs[:3])) * 10.0 < 1e-3
+
+
+def test_perturbation_swings_without_stretching():
+    """The rigid swing about the winch keeps every element's stretch: tensions equal the
+    trim's within 1e-6 relative when the pitch kick is off."""
+    from aerostat_gym.simulation import Model
+
+    env = TetheredAerostatEnv(turbulence="none", perturbation={"swing": 10.0, "lateral": 5.0})
+    obs, info = env.reset(seed=2, options={"wind_speed": 8.0})
+    ep = env.episode
+    model = Model(ep.params, 8.0)
+    t0, t1 = model.tensions(ep.x_trim), model.tensions(ep.x0)
+    assert np.allclose(t0, t1, rtol=1e-6)
+    assert abs(obs[0] * 10.0 - info["swing_m"]) < 0.05 * 10.0  # CM moves ~ the swing (5 %)
+
+
+def test_full_observation_holds_state_deviation():
+    env = gym.make(ENV_ID, observation="full")
+    obs, info = env.reset(seed=1)
+    lay = StateLayout(10)
+    assert obs.shape == (N_OBS + 1 + lay.size,)
+    assert obs[N_OBS] == pytest.approx(info["wind_speed"])
+    ep = env.unwrapped.episode
+    dev = (ep.x0 - ep.x_trim).astype(np.float32)
+    assert np.allclose(obs[N_OBS + 1:], dev, atol=1e-6)
+
+
+def test_nonfinite_state_terminates_with_failure_not_exception():
+    env = gym.make(ENV_ID)
+    env.reset(seed=0)
+    b = env.unwrapped._batch
+    b.X[0, 0] = np.nan  # a numerical failure, injected
+    obs, r, term, trunc, info = env.step(np.array([0.0], np.float32))
+    assert term and info["failure"] == "nonfinite_state"
+    assert np.all(np.isfinite(obs)) and math.isfinite(r)
+
+
+def test_ground_strike_terminates():
+    env = gym.make(ENV_ID, turbulence="none", perturbation="none", tether_length=150.0,
+                   wind_speed=(3.0, 3.0))
+    env.reset(seed=0)
+    b = env.unwrapped._batch
+    lay = b.layout
+    z = b.X[0, lay.cm_pos.start + 2]
+    b.X[0, lay.node_pos.start + 2:lay.node_pos.stop:3] *= 1.0 / z  # squash the system to the
+    b.X[0, lay.cm_pos.start + 2] = 1.0  # ground (elements go slack): CM below one diameter
+    _, r, term, _, info = env.step(np.array([0.0], np.float32))
+    assert term and info["termination"] == "ground_strike"
+    assert info["reward_termination"] == -100.0
+
+
+def test_vector_env_matches_single_envs():
+    n = 3
+    venv = gym.make_vec(ENV_ID, num_envs=n, vectorization_mode="vector_entry_point")
+    obs, _ = venv.reset(seed=40)
+    singles = [gym.make(ENV_ID) for _ in range(n)]
+    sobs = [s.reset(seed=40 + i)[0] for i, s in enumerate(singles)]
+    assert np.array_equal(obs, np.array(sobs))
+    rng = np.random.default_rng(1)
+    for _ in range(30):
+        a = rng.uniform(-1, 1, (n, 1)).astype(np.float32)
+        obs, rew, *_ = venv.step(a)
+        ref = [s.step(a[i]) for i, s in enumerate(singles)]
+        assert np.array_equal(obs, np.array([r[0] for r in ref]))
+        assert np.array_equal(rew, np.array([r[1] for r in ref]))
+
+
+def test_vector_env_next_step_autoreset():
+    venv = gym.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point",
+                        max_episode_steps=5)
+    venv.reset(seed=0)
+    a = np.zeros((2, 1), np.float32)
+    for _ in range(4):
+        _, _, term, trunc, _ = venv.step(a)
+        assert not trunc.any()
+    _, _, term, trunc, info = venv.step(a)
+    assert trunc.all() and not term.any()
+    _, rew, term, trunc, info = venv.step(a)  # the reset step
+    assert np.all(rew == 0.0) and not (term | trunc).any() and "reset_wind_speed" in info
+
+
+def test_sb3_adapter_is_a_vecenv():
+    from stable_baselines3.common.vec_env import VecEnv
+
+    venv = sb3_vec_env(4, seed=0, max_episode_steps=3)
+    assert isinstance(venv, VecEnv)
+    obs = venv.reset()
+    assert obs.shape == (4, N_OBS)
+    for _ in range(3):
+        obs, rew, dones, infos = venv.step(np.zeros((4, 1), np.float32))
+    assert dones.all()
+    assert infos[0]["TimeLimit.truncated"] and infos[0]["terminal_observation"].shape == (N_OBS,)
