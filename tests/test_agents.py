@@ -105,3 +105,15 @@ def test_full_training_reaches_shipped_score(tmp_path):
     shipped = suite_score(load_policy("agents/ppo_tethered_aerostat.zip"), "damping")
     best = max(e["score"] for e in json.loads((run / "evaluations.json").read_text()))
     assert best >= shipped - 0.1 * abs(shipped)
+
+
+def test_resume_from_checkpoint_continues(tmp_path):
+    """A run resumed from a saved model (with its VecNormalize statistics) keeps the step count."""
+    from stable_baselines3 import PPO
+
+    first = train("ppo", timesteps=2048, n_envs=8, seed=3, run_dir=tmp_path / "a",
+                  progress_bar=False, threads=1, eval_freq=10**9)
+    second = train("ppo", timesteps=2048, n_envs=8, seed=3, run_dir=tmp_path / "b",
+                   resume=first / "ppo_final.zip", progress_bar=False, threads=1,
+                   eval_freq=10**9)
+    assert PPO.load(second / "ppo_final.zip").num_timesteps == 4096

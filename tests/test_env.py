@@ -209,6 +209,16 @@ def test_vector_env_matches_single_envs():
         assert np.array_equal(rew, np.array([r[1] for r in ref]))
 
 
+def test_sync_vector_env_of_the_single_env_works():
+    """Gymnasium's SyncVectorEnv stacks the reset and step infos (same keys every episode)."""
+    venv = gym.make_vec(ENV_ID, num_envs=3, vectorization_mode="sync")
+    obs, info = venv.reset(seed=0)
+    assert obs.shape == (3, N_OBS) and info["_wind_speed"].all()
+    obs, rew, term, trunc, info = venv.step(np.zeros((3, 1), np.float32))
+    assert np.allclose(rew, info["reward_displacement"] + info["reward_velocity"]
+                       + sum(info["reward_" + k] for k in REWARD_TERMS[2:]))
+
+
 def test_vector_env_next_step_autoreset():
     venv = gym.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point",
                         max_episode_steps=5)

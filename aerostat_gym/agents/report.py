@@ -255,12 +255,13 @@ def _demo_command(args) -> int:
     print(f"  trim: CM x = {x:.1f} m, z = {z:.1f} m, blow-by {s['blow_by_deg']:.2f} deg, "
           f"pitch {s['pitch_deg']:.2f} deg, winch tension {s['bottom_tension_N'] / 1e3:.2f} kN")
     ana = analyse(params, eq)
-    print(f"  linear stability: all modes stable = {ana.all_stable}")
-    for subset, label in (("longitudinal", "pendulum"), ("longitudinal", "pitching"),
-                          ("longitudinal", "axial spring"), ("lateral", "pendulum")):
+    print(f"  linear stability: all modes stable = {ana.all_stable()}")
+    for subset, label in (("long", "pendulum"), ("long", "pitching"), ("long", "axial spring"),
+                          ("lat", "pendulum"), ("lat", "rolling")):
         m = ana.find(subset, label)
         if m is not None:
-            print(f"    {subset:12s} {label:13s} period {m.period:7.2f} s  damping {m.zeta:.3f}")
+            name = {"long": "longitudinal", "lat": "lateral"}[subset]
+            print(f"    {name:12s} {label:13s} period {m.period:7.2f} s  damping {m.zeta:.3f}")
     results = run_evaluations(["passive", "lqr", policy], "tiny")
     md = write_report(results, args.out, "aerostat-gym demo", "aerostat-gym demo")
     print()

@@ -120,8 +120,21 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     return run
 
 
+def _tensorboard_dir(run: Path) -> str | None:
+    """TensorBoard log directory, or None (with a warning) when tensorboard is not installed."""
+    import importlib.util
+    import warnings
+
+    if importlib.util.find_spec("tensorboard") is None:
+        warnings.warn("tensorboard is not installed (pip install aerostat-gym[train]): training "
+                      "runs without TensorBoard logs", stacklevel=3)
+        return None
+    return str(run / "tb")
+
+
 def _model(algo, hp, venv, seed, run, resume):
     Algo = _algorithm(algo)
+    tb = _tensorboard_dir(run)
     kwargs = {k: v for k, v in hp.items() if k not in RESERVED}
     if hp.get("policy_kwargs"):
         pk = dict(hp["policy_kwargs"])
@@ -136,10 +149,10 @@ def _model(algo, hp, venv, seed, run, resume):
         if not resume.is_file():
             raise TrainingError(f"checkpoint to resume not found: {resume}")
         model = Algo.load(resume, env=_load_vecnormalize_into(resume, venv), seed=seed,
-                          tensorboard_log=str(run / "tb"))
+                          tensorboard_log=tb)
         return model
-    return Algo(hp.get("policy", "MlpPolicy"), venv, seed=seed, verbose=0,
-                tensorboard_log=str(run / "tb"), **kwargs)
+    return Algo(hp.get("policy", "MlpPolicy"), venv, seed=seed, verbose=0, tensorboard_log=tb,
+                **kwargs)
 
 
 def _load_vecnormalize_into(checkpoint: Path, venv):

@@ -355,13 +355,14 @@ def _perturb(x_trim, params, pert, wp, ua, rng) -> tuple[np.ndarray, dict]:
     theta += pitch
     x[lay.euler] = (phi, theta, psi)
     x[lay.cm_pos] = conf - rotation_matrix(phi, theta, psi) @ leash
-    info = {"swing_m": swing, "lateral_m": lateral, "pitch_rad": pitch, "gust": None}
+    info = {"swing_m": swing, "lateral_m": lateral, "pitch_rad": pitch,
+            "gust_amplitude_m_s": 0.0, "gust_duration_s": 0.0, "gust_onset_s": 0.0}
     if rng.uniform() < pert["gust_probability"]:
         amp = rng.uniform(*pert["gust_amplitude"])
         dur = rng.uniform(*pert["gust_duration"])
         onset = rng.uniform(*pert["gust_onset"])
         set_gust(wp, (amp, 0.0, 0.0), dur * ua, onset)
-        info["gust"] = {"amplitude_m_s": amp, "duration_s": dur, "onset_s": onset}
+        info.update(gust_amplitude_m_s=amp, gust_duration_s=dur, gust_onset_s=onset)
     return x, info
 
 
