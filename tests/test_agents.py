@@ -117,3 +117,11 @@ def test_resume_from_checkpoint_continues(tmp_path):
                    resume=first / "ppo_final.zip", progress_bar=False, threads=1,
                    eval_freq=10**9)
     assert PPO.load(second / "ppo_final.zip").num_timesteps == 4096
+
+
+@pytest.mark.parametrize("algo", ["sac", "td3"])
+def test_off_policy_configs_train(tmp_path, algo):
+    """The shipped SAC and TD3 configurations build and run (a short smoke run)."""
+    run = train(algo, timesteps=1200, n_envs=4, seed=0, run_dir=tmp_path / algo,
+                progress_bar=False, threads=1, eval_freq=10**9)
+    assert (run / f"{algo}_final.zip").is_file()

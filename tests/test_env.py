@@ -244,3 +244,14 @@ def test_sb3_adapter_is_a_vecenv():
         obs, rew, dones, infos = venv.step(np.zeros((4, 1), np.float32))
     assert dones.all()
     assert infos[0]["TimeLimit.truncated"] and infos[0]["terminal_observation"].shape == (N_OBS,)
+
+
+def test_rendering_single_and_vector():
+    env = gym.make(ENV_ID, render_mode="rgb_array")
+    env.reset(seed=0)
+    assert env.render().shape == (480, 800, 3)
+    venv = gym.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point",
+                        render_mode="rgb_array")
+    venv.reset(seed=0)
+    frame = venv.render()
+    assert frame.shape == (480, 800, 3) and frame.dtype == np.uint8

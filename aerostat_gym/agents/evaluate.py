@@ -14,10 +14,7 @@ exactly. The suite score is the mean episode return under the environment's defa
 
 from __future__ import annotations
 
-import json
-import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -145,48 +142,3 @@ def suite_score(policy, suite: str = "tiny", control_step: float = 0.2) -> float
     for scenario, (speeds, seeds) in check_suite(suite).items():
         returns.extend(run_scenario(policy, scenario, speeds, seeds, control_step).returns)
     return float(np.mean(returns))
-
-
-# --- during training -------------------------------------------------------------------------
-
-def _callback_base():
-    from stable_baselines3.common.callbacks import BaseCallback
-
-    return BaseCallback
-
-
-class SuiteEvalCallback(_callback_base()):
-    """Every ``freq`` calls: score the current policy on the fixed suite (deterministic actions,
-    the training VecNormalize statistics), log it, append it to ``evaluations.json`` and save
-    the best model (with its statistics) as ``best_model.zip``."""
-
-    def __init__(self, suite: str, env_kwargs: dict, freq: int, run: Path, algo: str):
-        super().__init__(verbose=0)
-        check_suite(suite)
-        self.suite, self.freq, self.run, self.algo = suite, freq, Path(run), algo
-        self.best = -np.inf
-        self.history = []
-        self.t0 = time.perf_counter()
-
-    def _on_step(self) -> bool:
-        if self.n_calls % self.freq == 0:
-            self.evaluate_now()
-        return True
-
-    def _on_training_end(self) -> None:
-        if not self.history or self.history[-1]["timesteps"] != self.num_timesteps:
-            self.evaluate_now()
-
-    def evaluate_now(self) -> None:
-        from .baselines import SB3Policy
-        from .train import save_model
-
-        policy = SB3Policy(self.model, self.model.get_env())
-        score = suite_score(policy, self.suite)
-        self.logger.record("eval/suite_score", score)
-        self.history.append({"timesteps": int(self.num_timesteps), "score": score,
-                             "wall_time_s": time.perf_counter() - self.t0})
-        (self.run / "evaluations.json").write_text(json.dumps(self.history, indent=1))
-        if score > self.best:
-            self.best = score
-            save_model(self.model, self.run / "best_model.zip")

@@ -85,8 +85,6 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
     from stable_baselines3.common.utils import set_random_seed
 
-    from .evaluate import SuiteEvalCallback
-
     hp = load_hyperparams(algo, config)
     n_envs = int(n_envs or hp.get("n_envs", 8))
     timesteps = int(timesteps or hp.get("n_timesteps", 1e6))
@@ -103,8 +101,7 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     callbacks = CallbackList([
         CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"), name_prefix=algo,
                            save_vecnormalize=True),
-        SuiteEvalCallback(hp.get("eval_suite", "tiny"), env_kwargs, max(freq // n_envs, 1),
-                          run, algo),
+        suite_eval_callback(hp.get("eval_suite", "tiny"), max(freq // n_envs, 1), run),
     ])
     t0 = time.perf_counter()
     model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress_bar,
@@ -118,6 +115,45 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     (run / "training_summary.json").write_text(json.dumps(summary, indent=2))
     venv.close()
     return run
+
+
+def suite_eval_callback(suite: str, freq: int, run: Path):
+    """A callback that, every ``freq`` calls, scores the current policy on the fixed suite
+    (deterministic actions, the training VecNormalize statistics), logs it, appends it to
+    ``evaluations.json`` and saves the best-scoring model (with its statistics) as
+    ``best_model.zip``; it scores once more at the end of training."""
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    from .baselines import SB3Policy
+    from .evaluate import check_suite, suite_score
+
+    check_suite(suite)
+
+    class SuiteEvalCallback(BaseCallback):
+        def __init__(self):
+            super().__init__(verbose=0)
+            self.best, self.history, self.t0 = -np.inf, [], time.perf_counter()
+
+        def _on_step(self) -> bool:
+            if self.n_calls % freq == 0:
+                self.evaluate_now()
+            return True
+
+        def _on_training_end(self) -> None:
+            if not self.history or self.history[-1]["timesteps"] != self.num_timesteps:
+                self.evaluate_now()
+
+        def evaluate_now(self) -> None:
+            score = suite_score(SB3Policy(self.model, self.model.get_env()), suite)
+            self.logger.record("eval/suite_score", score)
+            self.history.append({"timesteps": int(self.num_timesteps), "score": score,
+                                 "wall_time_s": time.perf_counter() - self.t0})
+            (Path(run) / "evaluations.json").write_text(json.dumps(self.history, indent=1))
+            if score > self.best:
+                self.best = score
+                save_model(self.model, Path(run) / "best_model.zip")
+
+    return SuiteEvalCallback()
 
 
 def _tensorboard_dir(run: Path) -> str | None:

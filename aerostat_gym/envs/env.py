@@ -15,6 +15,17 @@ from .task import TaskConfig
 RENDER_MODES = ["human", "rgb_array"]
 
 
+def frame(s: dict):
+    """The renderer's Frame from an :meth:`EnvBatch.snapshot` (the episode's mean wind)."""
+    from .render import Frame
+
+    d = math.radians(s["params"].wind.direction_deg)
+    wind = s["wind_speed"] * np.array([math.cos(d), math.sin(d), 0.0])
+    return Frame(time=s["time"], nodes=s["nodes"], cm_pos=s["cm_pos"], euler=s["euler"],
+                 wind=wind, tension=s["tension"],
+                 length=s["length"], reel_speed=s["reel_speed"], trim_cm=s["trim_cm"])
+
+
 class TetheredAerostatEnv(gym.Env):
     """
     ## Description
@@ -194,17 +205,12 @@ class TetheredAerostatEnv(gym.Env):
             gym.logger.warn("render() called without a render_mode; pass render_mode="
                             "'rgb_array' or 'human' to gym.make")
             return None
-        from .render import Frame, Renderer
+        from .render import Renderer
 
         if self._renderer is None:
             self._renderer = Renderer(self._batch.params, self.render_mode,
                                       fps=self.metadata["render_fps"])
-        s = self._batch.snapshot(0)
-        wind = np.array([s["wind_speed"], 0.0, 0.0])
-        frame = Frame(time=s["time"], nodes=s["nodes"], cm_pos=s["cm_pos"], euler=s["euler"],
-                      wind=wind, tension=s["tension"], length=s["length"],
-                      reel_speed=s["reel_speed"], trim_cm=s["trim_cm"])
-        return self._renderer.render(frame)
+        return self._renderer.render(frame(self._batch.snapshot(0)))
 
     def close(self):
         if self._renderer is not None:

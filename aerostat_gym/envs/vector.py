@@ -21,7 +21,7 @@ from gymnasium.vector.utils import batch_space
 
 from . import spaces
 from .batch import EnvBatch
-from .env import TetheredAerostatEnv
+from .env import frame
 from .task import TaskConfig
 
 DEFAULT_MAX_EPISODE_STEPS = 600
@@ -107,15 +107,15 @@ class TetheredAerostatVectorEnv(VectorEnv):
         return b.OBS.copy(), rewards, terminated, truncated, info
 
     def render(self):
+        """An rgb_array frame of environment 0 (None without a render_mode)."""
         if self.render_mode is None:
             return None
+        from .render import Renderer
+
         if self._renderer is None:
-            self._renderer = TetheredAerostatEnv.__new__(TetheredAerostatEnv)
-            self._renderer.render_mode = "rgb_array"
-            self._renderer._renderer = None
-            self._renderer.metadata = {"render_fps": round(1.0 / self.task.control_step)}
-        self._renderer._batch = self.batch  # renders slot 0
-        return self._renderer.render()
+            self._renderer = Renderer(self.batch.params, "rgb_array",
+                                      fps=round(1.0 / self.task.control_step))
+        return self._renderer.render(frame(self.batch.snapshot(0)))
 
     def close_extras(self, **kwargs):
         if self._renderer is not None:
@@ -244,7 +244,7 @@ def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
                     infos[i]["terminal_observation"] = info["final_obs"][i]
                     infos[i]["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
                     for key in ("termination", "failure", "truncation"):
-                        if info.get("_" + key, np.zeros(1, bool))[i] if key in info else False:
+                        if key in info and info["_" + key][i]:
                             infos[i][key] = info[key][i]
             return obs, rew.astype(np.float32), dones, infos
 

@@ -515,13 +515,15 @@ def _aero_loads(x, p, w, R, o):
         k = WA + 3 * (i + 1)
         fu, fv, fw = _air_body(ub, vb, wb, pp, qq, rr, cx, cy, cz, R, w[k], w[k + 1], w[k + 2])
         ffx, ffy, ffz = _fin(fu, fv, fw, p, i)
-        Fx += ffx
-        Fy += ffy
-        Fz += ffz
-        Mx += cy * ffz - cz * ffy
-        My += cz * ffx - cx * ffz
-        Mz += cx * ffy - cy * ffx
+        Fx, Fy, Fz, Mx, My, Mz = _add_load(Fx, Fy, Fz, Mx, My, Mz, cx, cy, cz, ffx, ffy, ffz)
     return Fx, Fy, Fz, Mx, My, Mz
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _add_load(Fx, Fy, Fz, Mx, My, Mz, cx, cy, cz, fx, fy, fz):
+    """Add a force (fx, fy, fz) acting at body point (cx, cy, cz): F += f, M += c x f."""
+    return (Fx + fx, Fy + fy, Fz + fz, Mx + (cy * fz - cz * fy), My + (cz * fx - cx * fz),
+            Mz + (cx * fy - cy * fx))
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -542,12 +544,7 @@ def _aerostat(x, p, R, loads, flx, fly, flz, dx, o):
     fbx = R00 * flx + R10 * fly + R20 * flz
     fby = R01 * flx + R11 * fly + R21 * flz
     fbz = R02 * flx + R12 * fly + R22 * flz
-    Fx += fbx
-    Fy += fby
-    Fz += fbz
-    Mx += yl * fbz - zl * fby
-    My += zl * fbx - xl * fbz
-    Mz += xl * fby - yl * fbx
+    Fx, Fy, Fz, Mx, My, Mz = _add_load(Fx, Fy, Fz, Mx, My, Mz, xl, yl, zl, fbx, fby, fbz)
     # Kirchhoff inertial terms: M_e a_B = F + M_a (omega x V) - omega x (M_a V)
     max_, may, maz = p[P_MA], p[P_MA + 1], p[P_MA + 2]
     ox, oy, oz = qq * wb - rr * vb, rr * ub - pp * wb, pp * vb - qq * ub  # omega x V
