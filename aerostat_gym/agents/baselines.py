@@ -122,7 +122,7 @@ def load_sb3(path: str | Path) -> SB3Policy:
             norm = pickle.load(fh)
         norm.training = False
     shape = model.observation_space.shape
-    if len(shape) != 1 or shape[0] not in (N_OBS,) and shape[0] < N_OBS:
+    if len(shape) != 1 or shape[0] < N_OBS:
         raise PolicyError(f"{path} was trained on observations of shape {shape}; "
                           f"TetheredAerostat-v0 gives ({N_OBS},) (standard) or the full layout")
     return SB3Policy(model, norm)

@@ -18,11 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..envs.spaces import N_OBS
+from ..envs.spaces import CHANNELS, N_OBS
 from ..envs.vector import TetheredAerostatVectorEnv
 from .baselines import PolicyError, load_policy
 from .metrics import response_metrics
 
+I_TENSION = 12  # observation channel of the winch tension
 RECOVER = {"turbulence": "none",
            "perturbation": {"swing": 10.0, "pitch": 0.05, "fixed": True}}
 GUSTY = {"turbulence": "moderate", "perturbation": "none"}
@@ -79,7 +80,8 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     def record(k):
         rec["x"][:, k] = np.where(alive, b.X[:, ix] - b.XT[:, ix], np.nan)
         rec["pitch"][:, k] = np.where(alive, b.X[:, ith] - b.XT[:, ith], np.nan)
-        rec["tension"][:, k] = np.where(alive, obs[:, 12] * 1.0e4, np.nan)
+        rec["tension"][:, k] = np.where(alive, obs[:, I_TENSION] * CHANNELS[I_TENSION].scale,
+                                        np.nan)
         rec["reel"][:, k] = np.where(alive, b.X[:, iv], np.nan)
 
     record(0)

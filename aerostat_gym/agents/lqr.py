@@ -50,12 +50,11 @@ from ..analysis.modes import (
     AEROSTAT_MODES,
     Mode,
     ModeContext,
-    classify,
-    damp_quantities,
     energy_vector,
     mac,
     modal_table,
     mode_context,
+    modes_from_eig,
 )
 from ..analysis.trim import Equilibrium, find_equilibrium
 from ..params import Params, dumps_toml
@@ -169,23 +168,6 @@ def riccati_residual(A, B, Q, R, P) -> float:
 
 
 # --- modes ----------------------------------------------------------------------------------------
-
-
-def _mode_list(lam: np.ndarray, V: np.ndarray, ctx: ModeContext) -> list[Mode]:
-    """Modes (one per conjugate pair) of continuous eigenvalues ``lam`` with eigenvectors ``V``
-    whose first entries are in the longitudinal subset order of ``ctx``; sorted by wn."""
-    scale = max(float(np.max(np.abs(lam))), 1.0)
-    out = []
-    for k in np.argsort(np.abs(lam), kind="stable"):
-        ev = complex(lam[k])
-        if ev.imag < -1e-12 * scale:
-            continue
-        ev = complex(ev.real, 0.0) if abs(ev.imag) <= 1e-12 * scale else ev
-        wn, zeta, period = damp_quantities(ev)
-        label, energy, shape, sc = classify(V[:, k], ctx)
-        out.append(Mode(ev, V[:, k].copy(), wn, zeta, period, ev.imag > 0, ev.real < 0,
-                        wn < 1e-4, label, energy, shape, sc))
-    return out
 
 
 def _name_modes(modes: list[Mode], reference: list[Mode], ctx: ModeContext) -> None:
@@ -369,9 +351,9 @@ def _fill_modes(design: LQRDesign, params: Params, lin: LinearModel, long_w: np.
     s = np.log(z.astype(complex)) / design.dt
     design.closed_loop_eigenvalues = np.log(
         np.linalg.eigvals(design.closed_loop_matrix).astype(complex)) / design.dt
-    closed = _mode_list(s, V, ctx)
+    closed = modes_from_eig(s, V, ctx)
     lam, W = np.linalg.eig(lin.A_free[np.ix_(long_w, long_w)])
-    opened = _mode_list(lam, W, ctx)
+    opened = modes_from_eig(lam, W, ctx)
     for modes in (closed, opened):
         _name_modes(modes, braked, ctx)
     design.closed_loop, design.open_loop, design.braked = closed, opened, braked

@@ -197,8 +197,7 @@ def _load_vecnormalize_into(checkpoint: Path, venv):
 
     stats = vecnormalize_path(checkpoint)
     if isinstance(venv, VecNormalize) and stats.is_file():
-        loaded = VecNormalize.load(str(stats), venv.venv)
-        return loaded
+        return VecNormalize.load(str(stats), venv.venv)
     return venv
 
 

@@ -239,7 +239,14 @@ def modal_table(A_sub: np.ndarray, ctx: ModeContext) -> list[Mode]:
     eigenvalue, so an n-state subset has n / 2 modes when all are oscillatory; [LN02] counts
     3 n + 3 modes for the 6 n + 6 states, real eigenvalues counted in pairs.
     """
-    lam, V = np.linalg.eig(A_sub)
+    modes = modes_from_eig(*np.linalg.eig(A_sub), ctx)
+    resolve_duplicates(modes, ctx.subset)
+    return modes
+
+
+def modes_from_eig(lam: np.ndarray, V: np.ndarray, ctx: ModeContext) -> list[Mode]:
+    """Classified :class:`Mode` objects of eigenvalues ``lam`` and eigenvectors ``V`` (columns,
+    first entries in the subset order of ``ctx``), one per conjugate pair, sorted by |lambda|."""
     scale = max(float(np.max(np.abs(lam))), 1.0)
     modes = []
     for k in np.argsort(np.abs(lam), kind="stable"):
@@ -252,7 +259,6 @@ def modal_table(A_sub: np.ndarray, ctx: ModeContext) -> list[Mode]:
         label, energy, shape, sc = classify(V[:, k], ctx)
         modes.append(Mode(ev, V[:, k].copy(), wn, zeta, period, ev.imag > 0,
                           ev.real < 0 or neutral, neutral, label, energy, shape, sc))
-    resolve_duplicates(modes, ctx.subset)
     return modes
 
 

@@ -61,6 +61,7 @@ class EnvBatch:
         self.A = np.zeros(N)
         self.AP = np.zeros(N)
         self.BR = np.zeros(N, dtype=np.bool_)
+        self._clipped = np.zeros(N, dtype=np.bool_)
         self.P = np.zeros((N, P_SIZE))
         self.WP = np.zeros((N, W_SIZE))
         self.KF = np.zeros(N, dtype=np.int64)
@@ -130,19 +131,26 @@ class EnvBatch:
 
     def set_actions(self, actions) -> np.ndarray:
         """Validate and store actions, shape (N,) or (N, 1): NaN/inf is an ActionError,
-        out-of-range values are clipped to [-1, 1]. Returns the per-env clipped flags."""
+        out-of-range values are clipped to [-1, 1]. Returns the per-env clipped flags (a buffer
+        reused by the next call)."""
         a = np.asarray(actions, dtype=float)
         if a.size != self.num_envs:
             raise ActionError(f"expected {self.num_envs} action(s) of shape (1,), got shape "
                               f"{np.shape(actions)}")
         a = a.reshape(self.num_envs)
-        if not np.all(np.isfinite(a)):
-            bad = np.flatnonzero(~np.isfinite(a))
-            raise ActionError(f"action must be finite, got {a[bad][:4].tolist()} "
-                              f"(environment(s) {bad[:4].tolist()})")
-        clipped = np.abs(a) > 1.0
-        np.clip(a, -1.0, 1.0, out=self.A)
-        return clipped
+        scalar = self.num_envs == 1  # scalar arithmetic: each numpy call costs ~1 us per step
+        if not (math.isfinite(a[0]) if scalar else np.all(np.isfinite(a))):
+            idx = np.flatnonzero(~np.isfinite(a))
+            raise ActionError(f"action must be finite, got {a[idx][:4].tolist()} "
+                              f"(environment(s) {idx[:4].tolist()})")
+        if scalar:
+            v = float(a[0])
+            self._clipped[0] = abs(v) > 1.0
+            self.A[0] = min(max(v, -1.0), 1.0)
+        else:
+            np.greater(np.abs(a), 1.0, out=self._clipped)
+            np.clip(a, -1.0, 1.0, out=self.A)
+        return self._clipped
 
     def step(self, active: np.ndarray | None = None) -> None:
         """Advance every active environment one control step with the stored actions."""

@@ -9,7 +9,7 @@ import gymnasium as gym
 import numpy as np
 
 from . import spaces
-from .batch import ActionError, EnvBatch
+from .batch import EnvBatch
 from .task import TaskConfig
 
 RENDER_MODES = ["human", "rgb_array"]
@@ -154,7 +154,6 @@ class TetheredAerostatEnv(gym.Env):
         self.observation_space = gym.spaces.Box(b.obs_low, b.obs_high, dtype=np.float32)
         self.metadata = {**self.metadata, "render_fps": round(1.0 / self.task.control_step)}
         self._renderer = None
-        self._steps = 0
 
     # --- Gymnasium API ---------------------------------------------------------------------
 
@@ -163,27 +162,19 @@ class TetheredAerostatEnv(gym.Env):
         self._sync_horizon()
         info = self._batch.reset_one(0, self.np_random, options)
         self._batch.add_noise(0, self.np_random)
-        self._steps = 0
         if self.render_mode == "human":
             self.render()
         return self._batch.OBS[0].copy(), info
 
     def step(self, action):
         b = self._batch
-        a = np.asarray(action, dtype=float).reshape(-1)
-        if a.shape != (1,):
-            raise ActionError(f"action must have shape (1,), got {np.shape(action)}")
-        v = a[0]
-        if not math.isfinite(v):
-            raise ActionError(f"action must be finite, got {v!r}")
-        b.A[0] = min(max(v, -1.0), 1.0)
+        clipped = b.set_actions(action)
         b.step()
         b.add_noise(0, self.np_random)
-        self._steps += 1
         terms = b.TERMS[0]
         code = int(b.CODE[0])
         info = {"reward_" + k: terms[j] for j, k in enumerate(spaces.REWARD_TERMS)}
-        info["action_clipped"] = bool(abs(v) > 1.0)
+        info["action_clipped"] = bool(clipped[0])
         info["time"] = b.T[0]
         terminated = truncated = False
         if code != spaces.RUNNING:

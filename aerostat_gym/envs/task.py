@@ -279,8 +279,8 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, horizon: floa
     k = _speed_index(trims, opts.get("wind_speed"), rng)
     U = float(trims.speeds[k])
     params, x_trim = _parameters(task, trims, k, rng)
-    model = Model(params, U)
-    tension = trims.tensions[k] if params is trims.params else model.end_tensions(x_trim)[1]
+    tension = (trims.tensions[k] if params is trims.params
+               else Model(params, U).end_tensions(x_trim)[1])
     cfg = task.resolved["turbulence"]
     w = params.wind
     wp = pack_wind(w.profile, U, w.direction_deg, w.reference_height, w.shear_exponent,

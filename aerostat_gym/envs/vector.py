@@ -78,9 +78,8 @@ class TetheredAerostatVectorEnv(VectorEnv):
 
     def step(self, actions):
         b = self.batch
-        b.set_actions(actions)
+        clipped = b.set_actions(actions)
         pending = self._pending.copy()
-        clipped = np.abs(np.asarray(actions, float).reshape(self.num_envs)) > 1.0
         b.step(~pending)
         self._steps[~pending] += 1
         rewards = b.TERMS.sum(axis=1)
