@@ -13,7 +13,15 @@ import pytest
 from scipy.optimize import linear_sum_assignment
 
 from aerostat_gym.analysis.bench_linear import bench_sweep
-from aerostat_gym.analysis.figures import figure8_data, figure9_data, write_figure9
+from aerostat_gym.analysis.figures import (
+    FIG8_HEADINGS,
+    FIG8_VARIABLES,
+    figure8_data,
+    figure8_decomposition,
+    figure8_readings,
+    figure9_data,
+    write_figure9,
+)
 from aerostat_gym.analysis.linear import ACTUATORS, decouple, linearize
 from aerostat_gym.analysis.modes import (
     FIGURE9_MODES,
@@ -258,29 +266,48 @@ def fig8(base):
     return figure8_data(base)
 
 
-def test_figure8_paper_amplitude_regression(fig8):
-    """[LN02] amplitude, nodes at trim: nRMS x 22.5 %, y 9.0 %, z 5.8 %, phi 8.3 %, theta 8.2 %,
-    psi 7.6 % (regression band: 1.2 x these)."""
-    measured = {"x": 0.225, "y": 0.090, "z": 0.058, "phi": 0.083, "theta": 0.082, "psi": 0.076}
-    for k, v in measured.items():
-        assert fig8["nrms"][k] <= 1.2 * v, (k, fig8["nrms"][k])
+#: Measured nRMS for each reading of the [LN02] kick (figure8_readings, 80 s), keyed by
+#: (wind.direction_deg, tether nodes): x, y, z, phi, theta, psi, and the confluence-tension
+#: swing max |T / T_trim - 1|.
+FIG8_READINGS = {
+    (0.0, "trim"): (0.225, 0.090, 0.058, 0.083, 0.082, 0.076, 1.265),
+    (0.0, "relaxed"): (0.137, 0.089, 0.037, 0.083, 0.066, 0.075, 0.138),
+    (180.0, "trim"): (0.123, 0.040, 0.044, 0.047, 0.073, 0.041, 1.143),
+    (180.0, "relaxed"): (0.061, 0.051, 0.027, 0.054, 0.055, 0.051, 0.122),
+}
 
 
-def test_figure8_relaxed_tether_regression(base):
-    """[LN02] amplitude, tether nodes in the linear static equilibrium for the displaced
-    aerostat ("relaxed"): nRMS x 13.7 %, y 8.9 %, z 3.7 %, phi 8.3 %, theta 6.6 %, psi 7.5 %
-    (regression band: 1.2 x these); x, z and theta lower than with the nodes at trim."""
-    d = figure8_data(base, tether_nodes="relaxed")
-    assert d["status"] == "ok"
-    measured = {"x": 0.137, "y": 0.089, "z": 0.037, "phi": 0.083, "theta": 0.066, "psi": 0.075}
-    for k, v in measured.items():
-        assert d["nrms"][k] <= 1.2 * v, (k, d["nrms"][k])
+def test_figure8_readings_regression(base):
+    """[LN02] amplitude under each reading the paper leaves open (axes directions x tether
+    nodes): nRMS within 1.2 x the measured values above, tension swing within 5 %. No reading
+    brings all six to 5 %; the best, aerostat heading 0 with relaxed nodes, reaches 2.7-6.1 %."""
+    rows = figure8_readings(base)
+    assert len(rows) == len(FIG8_READINGS)
+    for r in rows:
+        key = (FIG8_HEADINGS[r["axes"]], r["tether_nodes"])
+        *expected, swing = FIG8_READINGS[key]
+        for (name, _unit), v in zip(FIG8_VARIABLES, expected, strict=True):
+            assert r[name] <= 1.2 * v, (key, name, r[name])
+        assert r["top_tension_swing"] == pytest.approx(swing, rel=0.05), key
 
 
-@pytest.mark.xfail(strict=False, reason="second-order effects of the 0.1 m / 0.01 rad kick: "
-                   "nRMS 6-23 % with the nodes at trim, 4-14 % with relaxed nodes; the nRMS scale "
-                   "in proportion to the amplitude (quadratic terms), a lateral-only kick is "
-                   "linear to 0.04 %, so the lateral misses are longitudinal x lateral coupling")
+@pytest.mark.parametrize("nodes", ["trim", "relaxed"])
+def test_figure8_odd_part_is_linear(base, nodes):
+    """At [LN02]'s full amplitude the part of the nonlinear response odd in the kick (first plus
+    third order) matches the linear response within 2 % nRMS for all six variables (measured
+    <= 1.17 % with the nodes at trim, <= 0.62 % relaxed), and the part even in the kick
+    (second order) accounts for the Figure 8 miss: |nRMS - even fraction| <= 0.015 (measured
+    <= 0.009). So the linearization is right at full amplitude; the miss is the quadratic terms
+    of the model, which no linear model has."""
+    for r in figure8_decomposition(base, tether_nodes=nodes):
+        assert r["odd_nrms"] <= 0.02, r
+        assert abs(r["nrms"] - r["even_fraction"]) <= 0.015, r
+
+
+@pytest.mark.xfail(strict=True, reason="second-order terms of the model at the 0.1 m / 0.01 rad "
+                   "kick (nRMS 3.7-22.5 %, see test_figure8_readings_regression): the part odd in "
+                   "the kick is linear to 1.2 %, the miss is the even part; the kick swings the "
+                   "confluence tension by 14-127 %")
 def test_figure8_paper_amplitude_within_5pct(fig8):
     """Issue 3 target: nRMS <= 5 % for each of the six variables at [LN02]'s amplitude."""
     assert max(fig8["nrms"].values()) <= 0.05, fig8["nrms"]
