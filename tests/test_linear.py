@@ -389,10 +389,9 @@ def test_bench_sweep_within_budget():
     assert res["linear_sweep_s"] <= 10.0
 
 
-# --- slow: full tables and scripts -------------------------------------------------------------
+# --- full tables and scripts (about 7 s together) -----------------------------------------
 
 
-@pytest.mark.slow
 def test_full_sensitivity_table(base):
     """Every knob evaluates at both ends; the headline movers of the lateral pendulum are the
     yaw-stiffness knobs (CB / CM x, fins, eta_k); Ixx, Ixz and tether drag move no Table 2
@@ -408,7 +407,6 @@ def test_full_sensitivity_table(base):
         assert rows[key]["max_abs_pct"] < 1.0
 
 
-@pytest.mark.slow
 def test_scripts_reproduce_into_folder(tmp_path):
     """The three reproduction scripts run and write their files."""
     import importlib.util
@@ -421,11 +419,11 @@ def test_scripts_reproduce_into_folder(tmp_path):
         mod = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(mod)
         assert mod.main(["--out", str(tmp_path), *extra]) == 0
-    for f in ("table2.json", "figure8.png", "figure8_amplitude_scan.csv", "figure9.png"):
+    for f in ("table2.json", "figure8.png", "figure8_amplitude_scan.csv", "figure8_readings.csv",
+              "figure8_decomposition.csv", "figure9.png"):
         assert (tmp_path / f).exists()
 
 
-@pytest.mark.slow
 def test_length_and_pitch_families_stable(base):
     """Tether lengths 150-375 m and trim pitch -8..0 deg: every mode stable 0..20 m/s."""
     from aerostat_gym.analysis.figures import FAMILIES, family_data
