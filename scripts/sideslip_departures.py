@@ -19,6 +19,7 @@ from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.envs.spaces import CHANNELS
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
 from aerostat_gym.params import load_params
+from aerostat_gym.physics.core import rotation_matrix
 from aerostat_gym.simulation import Model
 
 OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 80, 100)
@@ -41,13 +42,9 @@ def yaw_curve(stall_deg: float, wind_speed: float = 8.0) -> list[float]:
 
 def sideslip(euler: np.ndarray, v_rel: np.ndarray) -> np.ndarray:
     """Sideslip [deg] of the body velocity relative to the air, rows of Z-Y-X Euler angles."""
-    ph, th, ps = euler.T
-    cph, sph, cth, sth, cps, sps = np.cos(ph), np.sin(ph), np.cos(th), np.sin(th), np.cos(ps), np.sin(ps)
-    # body x and y axes in inertial components (columns 1 and 2 of the rotation matrix)
-    bx = np.stack([cth * cps, cth * sps, -sth], axis=1)
-    by = np.stack([sph * sth * cps - cph * sps, sph * sth * sps + cph * cps, sph * cth], axis=1)
-    u, v = np.sum(v_rel * bx, axis=1), np.sum(v_rel * by, axis=1)
-    return np.degrees(np.arctan2(np.abs(v), u))
+    R = np.array([rotation_matrix(*e) for e in euler])  # body to inertial, one per row
+    body = np.einsum("nij,ni->nj", R, v_rel)  # R^T v_rel: body-frame components
+    return np.degrees(np.arctan2(np.abs(body[:, 1]), body[:, 0]))
 
 
 def max_sideslip(turbulence: str, wind_speed: float, episodes: int) -> np.ndarray:
