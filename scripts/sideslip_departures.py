@@ -20,7 +20,7 @@ from aerostat_gym.envs.spaces import CHANNELS
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
 from aerostat_gym.params import load_params
 from aerostat_gym.physics.core import rotation_matrix
-from aerostat_gym.simulation import Model
+from aerostat_gym.sim import Model
 
 OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 80, 100)
 WIND = [i for i, c in enumerate(CHANNELS) if c.name in ("wind_x", "wind_y", "wind_z")]

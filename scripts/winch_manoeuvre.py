@@ -3,7 +3,7 @@
     python scripts/winch_manoeuvre.py [--wind 10] [--distance 50] [--integrator rk4]
                                       [--out winch_manoeuvre.png] [--set winch.max_speed=1.5]
 
-A thin shim over :func:`aerostat_gym.winch.reel_manoeuvre` (tested in tests/test_winch.py):
+A thin shim over :func:`aerostat_gym.analysis.manoeuvre.reel_manoeuvre` (tested in tests/test_winch.py):
 from the trim at the configured length, reel out ``distance`` metres at the winch's speed limit,
 hold, reel back in and let the aerostat settle; plot length, reel speed, winch tension and
 aerostat altitude.
@@ -16,9 +16,9 @@ import sys
 
 import numpy as np
 
-from aerostat_gym.cli import _overrides
+from aerostat_gym.analysis.manoeuvre import plot_manoeuvre, reel_manoeuvre
+from aerostat_gym.cli.common import parse_overrides
 from aerostat_gym.params import ParameterError, load_params
-from aerostat_gym.winch import plot_manoeuvre, reel_manoeuvre
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -34,7 +34,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default="winch_manoeuvre.png", help="output PNG")
     args = ap.parse_args(argv)
     try:
-        params = load_params(args.config, _overrides(args.set) or None)
+        params = load_params(args.config, parse_overrides(args.set) or None)
         res = reel_manoeuvre(params, args.wind, args.distance, args.speed, args.hold,
                              args.settle, args.integrator)
     except (ParameterError, ValueError) as exc:

@@ -7,13 +7,9 @@ import json
 import numpy as np
 import pytest
 
-from aerostat_gym.agents.baselines import (
-    PassivePolicy,
-    PolicyError,
-    TensionFeedbackPolicy,
-    load_policy,
-)
 from aerostat_gym.agents.evaluate import run_scenario
+from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy, load_policy
+from aerostat_gym.agents.sb3io import PolicyError
 from aerostat_gym.agents.train import train
 from aerostat_gym.cli import main
 from aerostat_gym.envs.spaces import N_OBS
@@ -80,8 +76,8 @@ def test_policy_for_another_observation_layout_is_rejected(tmp_path):
     import gymnasium as gym
     from stable_baselines3 import PPO
 
-    from aerostat_gym.agents.baselines import SB3Policy
     from aerostat_gym.agents.evaluate import policy_obs
+    from aerostat_gym.agents.sb3io import SB3Policy
 
     class Other(gym.Env):
         observation_space = gym.spaces.Box(-1, 1, (7,), np.float32)

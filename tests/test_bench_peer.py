@@ -20,7 +20,7 @@ import pytest
 
 pytest.importorskip("moordyn")
 
-from aerostat_gym.bench_peer import compare_with_moordyn  # noqa: E402
+from aerostat_gym.bench.moordyn import compare_with_moordyn  # noqa: E402
 
 POSITION_TOL = 0.5  # % of the tether length (issue target)
 TENSION_TOL = 2e-3  # relative, see the module docstring

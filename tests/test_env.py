@@ -25,7 +25,7 @@ from aerostat_gym.envs import (
     sb3_vec_env,
 )
 from aerostat_gym.envs.spaces import N_OBS
-from aerostat_gym.physics.layout import StateLayout
+from aerostat_gym.physics.state import StateLayout
 
 ENV_ID = "TetheredAerostat-v0"
 
@@ -147,7 +147,7 @@ def test_reset_starts_at_exact_trim_without_perturbation():
 def test_perturbation_swings_without_stretching():
     """The rigid swing about the winch keeps every element's stretch: tensions equal the
     trim's within 1e-6 relative when the pitch kick is off."""
-    from aerostat_gym.simulation import Model
+    from aerostat_gym.sim import Model
 
     env = TetheredAerostatEnv(turbulence="none", perturbation={"swing": 10.0, "lateral": 5.0})
     obs, info = env.reset(seed=2, options={"wind_speed": 8.0})
@@ -173,7 +173,7 @@ def test_nonfinite_state_terminates_with_failure_not_exception():
     env = gym.make(ENV_ID)
     env.reset(seed=0)
     b = env.unwrapped._batch
-    b.X[0, 0] = np.nan  # a numerical failure, injected
+    b.state[0, 0] = np.nan  # a numerical failure, injected
     obs, r, term, trunc, info = env.step(np.array([0.0], np.float32))
     assert term and info["failure"] == "nonfinite_state"
     assert np.all(np.isfinite(obs)) and math.isfinite(r)
@@ -185,9 +185,9 @@ def test_ground_strike_terminates():
     env.reset(seed=0)
     b = env.unwrapped._batch
     lay = b.layout
-    z = b.X[0, lay.cm_pos.start + 2]
-    b.X[0, lay.node_pos.start + 2:lay.node_pos.stop:3] *= 1.0 / z  # squash the system to the
-    b.X[0, lay.cm_pos.start + 2] = 1.0  # ground (elements go slack): CM below one diameter
+    z = b.state[0, lay.cm_pos.start + 2]
+    b.state[0, lay.node_pos.start + 2:lay.node_pos.stop:3] *= 1.0 / z  # squash the system to the
+    b.state[0, lay.cm_pos.start + 2] = 1.0  # ground (elements go slack): CM below one diameter
     _, r, term, _, info = env.step(np.array([0.0], np.float32))
     assert term and info["termination"] == "ground_strike"
     assert info["reward_termination"] == -100.0

@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from aerostat_gym.analysis.bench_linear import bench_sweep
 from aerostat_gym.analysis.figures import (
     FIG8_HEADINGS,
     FIG8_VARIABLES,
@@ -38,9 +37,10 @@ from aerostat_gym.analysis.reference import (
     table2,
     tether_harmonic_frequency,
 )
-from aerostat_gym.analysis.sensitivity import default_knobs, evaluate, solve_for_period
-from aerostat_gym.analysis.stability_cli import add_stability_parsers, parse_speeds
+from aerostat_gym.analysis.sensitivity import default_knobs, solve_for_period, stability_figures
 from aerostat_gym.analysis.trim import find_equilibrium
+from aerostat_gym.bench.linear import bench_sweep
+from aerostat_gym.cli.stability import add_stability_parsers, parse_speeds
 from aerostat_gym.params import load_params
 
 control = pytest.importorskip("control")
@@ -141,7 +141,7 @@ def test_input_matrix_and_state_space(sweep):
 
 def test_decouple_accepts_any_matrix(base):
     """decouple() splits an arbitrary matrix into exactly the layout's index sets (exact)."""
-    from aerostat_gym.physics.layout import StateLayout
+    from aerostat_gym.physics.state import StateLayout
 
     lay = StateLayout(4)
     A = np.arange(30 * 30, dtype=float).reshape(30, 30)
@@ -330,8 +330,8 @@ def test_sensitivity_eta_k_moves_lateral_pendulum_only(base):
     """eta_k 0.3 (baseline 0.4) lengthens the lateral pendulum at 1 m/s by > 5 % (67.6 -> 74.7 s)
     and moves the longitudinal Table 2 periods by < 0.5 %."""
     knob = next(k for k in default_knobs(base) if k.key == "hull.eta_k")
-    b = evaluate(base, speeds=(1.0,))
-    lo = evaluate(knob.put(base, 0.3), speeds=(1.0,))
+    b = stability_figures(base, speeds=(1.0,))
+    lo = stability_figures(knob.put(base, 0.3), speeds=(1.0,))
     assert lo["lat_pendulum"] > 1.05 * b["lat_pendulum"]
     for key in ("long_pendulum", "axial_spring", "tether_1st"):
         assert lo[key] == pytest.approx(b[key], rel=0.005)
@@ -344,7 +344,7 @@ def test_solve_for_period_hits_target(base):
     v = solve_for_period(base, knob, 74.14)
     assert v is not None and knob.low <= v <= knob.high
     p = knob.put(base, v)
-    assert evaluate(p, speeds=(1.0,))["lat_pendulum"] == pytest.approx(74.14, abs=0.01)
+    assert stability_figures(p, speeds=(1.0,))["lat_pendulum"] == pytest.approx(74.14, abs=0.01)
 
 
 # --- CLI and timing -----------------------------------------------------------------------------

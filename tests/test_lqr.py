@@ -9,18 +9,12 @@ ratio open loop -> LQR: 5 m/s 0.151 -> 0.158, 10 m/s 0.275 -> 0.355, 15 m/s 0.35
 import numpy as np
 import pytest
 
-from aerostat_gym.agents.lqr import (
-    OBS_STATE_OFFSET,
-    OBS_WIND_INDEX,
-    LQRPolicy,
-    LQRSchedule,
-    design_lqr,
-    mode_initial_state,
-)
+from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule, design_lqr, mode_initial_state
 from aerostat_gym.agents.metrics import fit_damped_sinusoid
+from aerostat_gym.envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
 from aerostat_gym.params import load_params
-from aerostat_gym.physics.layout import StateLayout
-from aerostat_gym.simulation import simulate
+from aerostat_gym.physics.state import StateLayout
+from aerostat_gym.sim import simulate
 
 DT = 0.2
 SPEEDS = (5.0, 10.0, 15.0)
@@ -43,9 +37,9 @@ def schedule(params):
 
 
 def full_obs(layout, U, dx):
-    obs = np.zeros(OBS_STATE_OFFSET + layout.size, dtype=np.float32)
-    obs[OBS_WIND_INDEX] = U
-    obs[OBS_STATE_OFFSET:] = dx
+    obs = np.zeros(OBS_FULL_STATE + layout.size, dtype=np.float32)
+    obs[OBS_FULL_WIND] = U
+    obs[OBS_FULL_STATE:] = dx
     return obs
 
 
@@ -128,7 +122,7 @@ def test_policy_shapes_and_errors(schedule, params):
     obs = full_obs(lay, 10.0, dx)
     a, z = policy.predict(obs)
     assert a.shape == (1,) and a.dtype == np.float32 and z.shape == (1,)
-    expected = -schedule.gain(10.0)[:-1] @ obs[OBS_STATE_OFFSET:].astype(float)
+    expected = -schedule.gain(10.0)[:-1] @ obs[OBS_FULL_STATE:].astype(float)
     assert a[0] == pytest.approx(expected / params.winch.max_speed, abs=1e-6)
     A, Z = policy.predict(np.stack([obs, obs, obs]))
     assert A.shape == (3, 1) and Z.shape == (3,)
@@ -186,8 +180,8 @@ def test_nonlinear_pendulum_damping_matches_linear(params):
     def u(t, x):
         dx = x - design.x_trim
         dx[ipsi] = (dx[ipsi] + np.pi) % (2 * np.pi) - np.pi
-        obs = np.zeros(OBS_STATE_OFFSET + lay.size)
-        obs[OBS_WIND_INDEX], obs[OBS_STATE_OFFSET:] = 10.0, dx
+        obs = np.zeros(OBS_FULL_STATE + lay.size)
+        obs[OBS_FULL_WIND], obs[OBS_FULL_STATE:] = 10.0, dx
         a, state["z"] = policy.predict(obs, state["z"])
         return [float(a[0]) * params.winch.max_speed, 0.0]
 

@@ -121,7 +121,7 @@ def test_user_file_and_overrides(tmp_path, base):
 
 def test_packed_offsets_match_field_table():
     """The literal P_* offsets of the packed parameter vector equal the running sum of _FIELDS."""
-    from aerostat_gym.physics import layout
+    from aerostat_gym.physics import packing as layout
 
     off = 0
     for name, size in layout._FIELDS:

@@ -12,7 +12,7 @@ from aerostat_gym.analysis.energy import mechanical_energy
 from aerostat_gym.analysis.signals import zero_crossing_period
 from aerostat_gym.analysis.trim import TrimError, find_equilibrium
 from aerostat_gym.params import load_params
-from aerostat_gym.simulation import Model, SimulationError, simulate
+from aerostat_gym.sim import Model, SimulationError, simulate
 
 AERO_OFF = {"hull.CD0": 0.0, "hull.Cdc": 0.0, "hull.eta_k": 0.0, "fins.CL_alpha": 0.0,
             "fins.CD0": 0.0, "tether.Cd_normal": 0.0, "tether.damping_ratio": 0.0}
@@ -34,7 +34,7 @@ def test_zero_wind_trim_closed_form(base, trim0):
     d, s = base.derived, trim0.summary
     assert s["blow_by_deg"] < 1e-6
     assert s["top_tension_N"] == pytest.approx(d.net_lift, rel=1e-6)
-    assert s["bottom_tension_N"] == pytest.approx(d.net_lift - d.tether_weight, rel=1e-6)
+    assert s["winch_tension_N"] == pytest.approx(d.net_lift - d.tether_weight, rel=1e-6)
     assert abs(math.radians(s["pitch_deg"]) - math.radians(base.aerostat.trim_pitch_deg)) < 1e-6
     assert trim0.residual <= 1e-9
 

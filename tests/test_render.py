@@ -23,8 +23,8 @@ from aerostat_gym.envs.render import (  # noqa: E402
     hull_pixel_center,
 )
 from aerostat_gym.params import load_params  # noqa: E402
-from aerostat_gym.physics.layout import StateLayout  # noqa: E402
-from aerostat_gym.simulation import Model  # noqa: E402
+from aerostat_gym.physics.state import StateLayout  # noqa: E402
+from aerostat_gym.sim import Model  # noqa: E402
 
 HULL_RGB = np.array([round(255 * c) for c in to_rgb(HULL_COLOR)])
 COLOR_TOL = 6  # per channel: interior pixels of a filled polygon are exact in Agg (+-1 rounding)

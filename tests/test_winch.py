@@ -9,18 +9,13 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
+from aerostat_gym.analysis.linear import ACTUATORS, U_FREE, input_jacobian
+from aerostat_gym.analysis.manoeuvre import length_hold_law, reel_manoeuvre
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.params import load_params
-from aerostat_gym.physics.layout import P_MU
-from aerostat_gym.simulation import Model, SimulationError, simulate
-from aerostat_gym.winch import (
-    WinchController,
-    WinchInputError,
-    length_hold_law,
-    motor_force,
-    reel_manoeuvre,
-    winch_input_column,
-)
+from aerostat_gym.physics.packing import P_MU
+from aerostat_gym.sim import Model, SimulationError, simulate
+from aerostat_gym.sim.winch import WinchController, WinchInputError, motor_force
 
 INTEGRATORS = ("rk4", "semi-implicit")
 U = 10.0
@@ -68,7 +63,7 @@ def test_lumped_model_carries_the_paid_out_mass(base):
     eq = find_equilibrium(base, 0.0, length=350.0)
     wc = WinchController(base)
     expected = base.derived.net_lift - float(wc.mass_aloft(350.0)) * base.environment.g
-    assert eq.summary["bottom_tension_N"] == pytest.approx(expected, rel=1e-6)
+    assert eq.summary["winch_tension_N"] == pytest.approx(expected, rel=1e-6)
 
 
 def test_drum_must_hold_the_line(base):
@@ -272,7 +267,7 @@ def test_input_column_matches_step_response(base, trim10):
     the winch tension."""
     m = Model(base, U)
     lay, x0 = m.layout, trim10.x
-    B = winch_input_column(m, x0)
+    B = input_jacobian(m, x0, U_FREE.copy(), ACTUATORS, 1e-3)[:, 0]
     expect = np.zeros_like(B)
     expect[lay.winch_speed] = 1.0 / base.winch.speed_time_constant
     np.testing.assert_allclose(B, expect, rtol=0, atol=1e-6)
@@ -327,13 +322,13 @@ def test_winch_events_and_load_cell(base, trim10):
     """Load cell = winch-end tension; with thresholds set inside the manoeuvre's tension range
     the over-tension and slack onsets are reported with value and threshold; the thresholds
     travel with the trajectory."""
-    T_trim = trim10.summary["bottom_tension_N"]
+    T_trim = trim10.summary["winch_tension_N"]
     p = base.replace(**{"winch.safe_working_load": T_trim + 300.0,
                         "winch.slack_tension": T_trim - 300.0})
     law = length_hold_law(lambda t: 310.0 if t < 15.0 else 300.0, 1.0, 1.0,
                           Model(p).layout.winch_length)
     tr = simulate(p, trim10.x, 40.0, wind=U, output_dt=0.1, u=law)
-    np.testing.assert_array_equal(tr.load_cell, tr.bottom_tension)
+    np.testing.assert_array_equal(tr.load_cell, tr.winch_tension)
     names = [e["event"] for e in tr.events]
     assert "over_tension" in names and "winch_slack" in names
     for e in tr.events:

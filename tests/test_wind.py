@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 import scipy.integrate
 
+from aerostat_gym.bench.wind import bench_wind
 from aerostat_gym.physics.wind import (
     NO_FIELD,
     W_FIELD_DT,
@@ -39,7 +40,6 @@ from aerostat_gym.wind import (
     spectra,
     stats,
 )
-from aerostat_gym.wind.bench import bench_wind
 
 U = 8.0
 FAST = {"sigma_u": 1.6, "sigma_v": 1.28, "sigma_w": 0.96, "L_u": 80.0, "L_v": 40.0, "L_w": 30.0,
@@ -169,7 +169,7 @@ def test_field_drives_the_simulation_through_the_core():
     """Item 3: the same (wp, wf) feed the compiled core and its integrator substeps."""
     trim = pytest.importorskip("aerostat_gym.analysis.trim")
     from aerostat_gym.params import default_params
-    from aerostat_gym.simulation import simulate
+    from aerostat_gym.sim import simulate
 
     p = default_params()
     eq = trim.find_equilibrium(p, U)  # the trim sees the mean wind only

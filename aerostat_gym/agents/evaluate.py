@@ -18,12 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..envs.spaces import CHANNELS, N_OBS
+from ..envs.spaces import CHANNELS, N_OBS, OBS_TENSION
 from ..envs.vector import TetheredAerostatVectorEnv
-from .baselines import PolicyError, load_policy
 from .metrics import response_metrics
+from .policies import load_policy
+from .sb3io import PolicyError
 
-I_TENSION = 12  # observation channel of the winch tension
 RECOVER = {"turbulence": "none",
            "perturbation": {"swing": 10.0, "pitch": 0.05, "fixed": True}}
 GUSTY = {"turbulence": "moderate", "perturbation": "none"}
@@ -78,11 +78,11 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     state, start = None, np.ones(len(pairs), bool)
 
     def record(k):
-        rec["x"][:, k] = np.where(alive, b.X[:, ix] - b.XT[:, ix], np.nan)
-        rec["pitch"][:, k] = np.where(alive, b.X[:, ith] - b.XT[:, ith], np.nan)
-        rec["tension"][:, k] = np.where(alive, obs[:, I_TENSION] * CHANNELS[I_TENSION].scale,
+        rec["x"][:, k] = np.where(alive, b.state[:, ix] - b.trim_state[:, ix], np.nan)
+        rec["pitch"][:, k] = np.where(alive, b.state[:, ith] - b.trim_state[:, ith], np.nan)
+        rec["tension"][:, k] = np.where(alive, obs[:, OBS_TENSION] * CHANNELS[OBS_TENSION].scale,
                                         np.nan)
-        rec["reel"][:, k] = np.where(alive, b.X[:, iv], np.nan)
+        rec["reel"][:, k] = np.where(alive, b.state[:, iv], np.nan)
 
     record(0)
     for k in range(1, steps + 1):
@@ -120,7 +120,7 @@ def episode_metrics(ep: Episodes, i: int) -> dict:
     return m
 
 
-def evaluate(policy_name: str, suite: str = "tiny", control_step: float = 0.2,
+def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float = 0.2,
              params=None) -> dict:
     """Metrics of one policy on a suite: {scenario: [per-episode metrics]}, plus the score."""
     spec = check_suite(suite)

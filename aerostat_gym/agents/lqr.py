@@ -12,7 +12,7 @@ Design (:func:`design_lqr`) at one mean wind speed U:
 4. augment an integral state on the tether-length deviation, z_{k+1} = z_k + dt (L_k - L0), so a
    constant disturbance (a wind-speed error in the schedule, a length offset) leaves no
    steady length error;
-5. Bryson weights Q = diag(1 / dx_max^2), R = 1 / v_max^2 (:data:`DEFAULT_WEIGHTS`), solve the
+5. Bryson weights Q = diag(1 / dx_max^2), R = 1 / v_max^2 (:data:`LQR_MAX_DEVIATIONS`), solve the
    discrete algebraic Riccati equation (:func:`scipy.linalg.solve_discrete_are`) and form
    K = (R + B^T P B)^-1 B^T P A. The command is v_set = -K [x - x_trim; z].
 
@@ -57,13 +57,9 @@ from ..analysis.modes import (
     modes_from_eig,
 )
 from ..analysis.trim import Equilibrium, find_equilibrium
+from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
 from ..params import Params, dumps_toml
-from ..physics.layout import StateLayout
-
-#: Full observation layout of the environment (``observation="full"``): index of the episode's
-#: mean wind speed, and first index of the state deviation x - x_trim (6n+8 entries).
-OBS_WIND_INDEX = 19
-OBS_STATE_OFFSET = 20
+from ..physics.state import StateLayout
 
 #: Bryson "largest acceptable deviation" of each state group (SI units), the integral of the
 #: length error [m s], and the set-point (``None``: params.winch.max_speed). Q_ii = 1 / value^2.
@@ -72,7 +68,7 @@ OBS_STATE_OFFSET = 20
 #: (m/s)/rad (0.05 rad and 0.02 rad/s give gains near 20 (m/s)/(rad/s) at 5 m/s, which chatter
 #: the winch on pitch oscillations and ride its 0.5 m/s^2 acceleration limit). Tether nodes get
 #: small weights: their motion follows the aerostat's and the winch cannot shape it.
-DEFAULT_WEIGHTS: dict[str, float | None] = {
+LQR_MAX_DEVIATIONS: dict[str, float | None] = {
     "node_pos": 50.0,  # m, every moving tether node, x y z
     "node_vel": 10.0,  # m/s
     "cm_pos": 5.0,  # m, aerostat CM x y z
@@ -102,7 +98,7 @@ class LQRDesignError(RuntimeError):
 
 
 def _weights(params: Params, weights: dict | None) -> dict:
-    w = dict(DEFAULT_WEIGHTS)
+    w = dict(LQR_MAX_DEVIATIONS)
     for k, v in (weights or {}).items():
         if k not in w:
             raise ValueError(f"unknown LQR weight {k!r}; known: {', '.join(w)}")
@@ -290,10 +286,18 @@ def design_lqr(params: Params, wind_speed: float, dt: float = 0.2, weights: dict
 
     Parameters
     ----------
-    params : Params. wind_speed : trim wind speed [m/s]. dt : control step [s] (ZOH).
-    weights : overrides of :data:`DEFAULT_WEIGHTS` (maximum acceptable deviations).
-    equilibrium : a trim at ``wind_speed`` to reuse (default: computed).
-    subset : "auto" (full model, longitudinal + winch subset if the full DARE fails), "full" or
+    params : Params
+        The aerostat, tether and winch.
+    wind_speed : float
+        Trim wind speed [m/s].
+    dt : float
+        Control step [s] (zero-order hold).
+    weights : dict, optional
+        Overrides of :data:`LQR_MAX_DEVIATIONS` (maximum acceptable deviations).
+    equilibrium : Equilibrium, optional
+        A trim at ``wind_speed`` to reuse (default: computed).
+    subset : str
+        "auto" (full model, longitudinal + winch subset if the full DARE fails), "full" or
         "long".
 
     Raises
@@ -398,7 +402,7 @@ class LQRSchedule:
     ----------
     params : Params. speeds : design wind speeds [m/s], increasing (default
     :data:`DEFAULT_SPEEDS`, 2 to 16 m/s in 1 m/s steps). dt : control step [s].
-    weights : overrides of :data:`DEFAULT_WEIGHTS`. subset : see :func:`design_lqr`.
+    weights : overrides of :data:`LQR_MAX_DEVIATIONS`. subset : see :func:`design_lqr`.
 
     Attributes
     ----------
@@ -453,10 +457,6 @@ class LQRSchedule:
         the table's end speeds."""
         return self._interp(self.gains, U)
 
-    def trim_state(self, U) -> np.ndarray:
-        """Trim state interpolated linearly in U (clamped), like :meth:`gain`."""
-        return self._interp(self.trims, U)
-
     # --- persistence ------------------------------------------------------------------------
 
     def save(self, path: str | Path) -> Path:
@@ -505,15 +505,20 @@ class LQRPolicy:
 
     Parameters
     ----------
-    params : Params of the environment. dt : control step [s] (must match the schedule's).
-    schedule : an :class:`LQRSchedule` (default: built here, a few seconds).
-    privileged : True (the only mode implemented): the policy reads the exact state deviation
-        and the episode's mean wind speed from the ``observation="full"`` vector.
+    params : Params
+        Parameters of the environment.
+    dt : float
+        Control step [s] (must match the schedule's).
+    schedule : LQRSchedule, optional
+        The gain table (default: built here, a few seconds).
+    privileged : bool
+        True (the only mode implemented): the policy reads the exact state deviation and the
+        episode's mean wind speed from the ``observation="full"`` vector.
 
     Notes
     -----
-    Observation (``observation="full"``): index 19 holds U, indices 20 .. 20 + 6n+8 hold
-    x - x_trim. The set-point is v = -K(U) [dx; z], clipped to +-max_speed, and the action is
+    Observation (``observation="full"``): index ``OBS_FULL_WIND`` holds U, the 6n+8 entries
+    from ``OBS_FULL_STATE`` hold x - x_trim. The set-point is v = -K(U) [dx; z], clipped to +-max_speed, and the action is
     v / max_speed. The integral z (one per environment) travels in ``state``: z <- z + dt dL,
     except while the command is saturated and integrating would push it further into
     saturation (conditional-integration anti-windup); ``episode_start`` resets it to 0.
@@ -535,7 +540,7 @@ class LQRPolicy:
             raise ValueError(f"schedule gains have {self.schedule.gains.shape[1]} columns, "
                              f"expected {self.layout.size + 1} for n = {self.layout.n_elements}")
         self.max_speed = float(params.winch.max_speed)
-        self.obs_size = OBS_STATE_OFFSET + self.layout.size
+        self.obs_size = OBS_FULL_STATE + self.layout.size
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """(actions, state): actions (1,) for one observation or (N, 1) for a batch, float32 in
@@ -556,8 +561,8 @@ class LQRPolicy:
         if episode_start is not None:
             start = np.asarray(episode_start, dtype=bool).reshape(-1)
             z[np.broadcast_to(start, (N,))] = 0.0
-        U = obs2[:, OBS_WIND_INDEX]
-        dx = obs2[:, OBS_STATE_OFFSET:OBS_STATE_OFFSET + self.layout.size].copy()
+        U = obs2[:, OBS_FULL_WIND]
+        dx = obs2[:, OBS_FULL_STATE:OBS_FULL_STATE + self.layout.size].copy()
         ipsi = self.layout.euler.start + 2
         dx[:, ipsi] = (dx[:, ipsi] + np.pi) % (2.0 * np.pi) - np.pi
         K = self.schedule.gain(U)
@@ -574,9 +579,16 @@ class LQRPolicy:
     def predicted_modes(self, wind_speed: float) -> dict:
         """The linear model's open- and closed-loop pendulum, pitching and axial-spring modes of
         the design at the table speed nearest ``wind_speed`` (:meth:`LQRDesign.summary`)."""
-        k = int(np.argmin(np.abs(self.schedule.speeds - wind_speed)))
-        return {"design_wind_speed": float(self.schedule.speeds[k]),
-                **self.schedule.designs[k].summary()}
+        sch = self.schedule
+        k = int(np.argmin(np.abs(sch.speeds - wind_speed)))
+        out = {"design_wind_speed": float(sch.speeds[k])}
+        if sch.designs is not None:
+            return {**out, **sch.designs[k].summary()}
+        # a schedule read from disk keeps the predicted damping ratios, not the designs
+        for label, table in (("pendulum", sch.pendulum_zeta), ("pitching", sch.pitch_zeta)):
+            out[label] = {loop: {"zeta": float(table[k, j]), "period_s": math.nan}
+                          for j, loop in enumerate(("open", "closed"))}
+        return out
 
     def reset(self) -> None:
         """Stateless between calls: the integral lives in ``state`` (kept for API symmetry)."""

@@ -353,15 +353,3 @@ def response_metrics(time, x_disp, pitch, tension, reel_speed, *,
         "peak_reel_speed_m_s": float(np.max(np.abs(v))) if v.size else NAN,
     }
 
-
-def trajectory_metrics(traj, x_trim, **kwargs) -> dict:
-    """:func:`response_metrics` of a :class:`aerostat_gym.simulation.Trajectory` about the trim
-    state ``x_trim`` (along-wind = inertial X; tension at the winch end)."""
-    from ..physics.layout import StateLayout
-
-    n = (np.asarray(x_trim).size - 8) // 6
-    lay = StateLayout(n)
-    x0 = np.asarray(x_trim, dtype=float)
-    return response_metrics(traj.time, traj.cm_pos[:, 0] - x0[lay.cm_pos][0],
-                            traj.euler[:, 1] - x0[lay.euler][1], traj.bottom_tension,
-                            traj.reel_speed, **kwargs)

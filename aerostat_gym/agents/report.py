@@ -1,18 +1,15 @@
-"""Evaluation reports (Markdown table, PNG plots, JSON) and the ``evaluate`` and ``demo``
-commands."""
+"""Evaluation reports: Markdown tables, PNG plots and JSON of evaluation results."""
 
 from __future__ import annotations
 
 import json
 import math
-import time
 from pathlib import Path
 
 import numpy as np
 
-from .evaluate import SUITES, evaluate
+from .evaluate import SUITES, evaluate_policy
 
-SHIPPED_POLICY = "agents/ppo_tethered_aerostat.zip"
 COLUMNS = [  # (key, header, format)
     ("pendulum_zeta", "pend. zeta", "{:.3f}"), ("pendulum_period_s", "pend. T [s]", "{:.1f}"),
     ("pitch_zeta", "pitch zeta", "{:.3f}"), ("pitch_period_s", "pitch T [s]", "{:.2f}"),
@@ -170,11 +167,11 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
             parts += [f"![{p.stem}]({p.name})", ""]
     md = out / "report.md"
     md.write_text("\n".join(parts))
-    (out / "report.json").write_text(json.dumps(_jsonable(results), indent=1))
+    (out / "report.json").write_text(json.dumps(jsonable(results), indent=1))
     return md
 
 
-def _jsonable(results: list[dict]) -> list[dict]:
+def jsonable(results: list[dict]) -> list[dict]:
     out = []
     for r in results:
         r2 = {k: v for k, v in r.items() if k != "scenarios"}
@@ -186,7 +183,7 @@ def _jsonable(results: list[dict]) -> list[dict]:
 def run_evaluations(policies: list[str], suite: str, progress: bool = True) -> list[dict]:
     results = []
     for name in _progress(policies, progress, "evaluating"):
-        r = evaluate(name, suite)
+        r = evaluate_policy(name, suite)
         r["label"] = Path(name).stem if name.endswith(".zip") else name
         results.append(r)
     return results
@@ -200,103 +197,3 @@ def _progress(items, enabled: bool, desc: str):
     except ImportError:  # pragma: no cover
         return items
     return tqdm(items, desc=desc)
-
-
-# --- commands --------------------------------------------------------------------------------
-
-
-def add_evaluate_parser(sub) -> None:
-    p = sub.add_parser("evaluate", help="evaluate policies on a frozen seed suite")
-    p.add_argument("--policy", action="append", required=True,
-                   help="passive, tension, lqr or PATH.zip (repeat to compare)")
-    p.add_argument("--suite", choices=list(SUITES), default="tiny")
-    p.add_argument("--out", default="runs/evaluate", help="report directory")
-    p.add_argument("--json", action="store_true", help="print the metrics as JSON")
-    p.add_argument("--no-plots", action="store_true")
-    p.set_defaults(func=_evaluate_command)
-
-
-def _evaluate_command(args) -> int:
-    import sys
-
-    results = run_evaluations(args.policy, args.suite, progress=not args.json)
-    md = write_report(results, args.out, f"Evaluation on suite `{args.suite}`",
-                      "aerostat-gym " + " ".join(sys.argv[1:]), plots=not args.no_plots)
-    if args.json:
-        print(json.dumps(_jsonable(results), indent=1))
-    else:
-        print(md.read_text())
-        print(f"\nreport: {md}")
-    return 0
-
-
-def add_demo_parser(sub) -> None:
-    p = sub.add_parser("demo", help="the main job: trim, stability summary, shipped policy vs "
-                                    "baselines on the tiny suite, report in runs/demo/")
-    p.add_argument("--wind", type=float, default=10.0, help="wind speed of the summary [m/s]")
-    p.add_argument("--policy", default=SHIPPED_POLICY, help="policy to compare (default: shipped)")
-    p.add_argument("--out", default="runs/demo")
-    p.set_defaults(func=_demo_command)
-
-
-def _demo_command(args) -> int:
-    from ..analysis.modes import analyse
-    from ..analysis.trim import find_equilibrium
-    from ..params import load_params
-
-    t0 = time.perf_counter()
-    policy = _shipped(args.policy)
-    params = load_params()
-    eq = find_equilibrium(params, args.wind)
-    s = eq.summary
-    print(f"aerostat-gym demo: baseline aerostat, L = {params.tether.length:g} m, "
-          f"U = {args.wind:g} m/s")
-    x, _, z = s["aerostat_position_m"]
-    print(f"  trim: CM x = {x:.1f} m, z = {z:.1f} m, blow-by {s['blow_by_deg']:.2f} deg, "
-          f"pitch {s['pitch_deg']:.2f} deg, winch tension {s['bottom_tension_N'] / 1e3:.2f} kN")
-    ana = analyse(params, eq)
-    print(f"  linear stability: all modes stable = {ana.all_stable()}")
-    for subset, label in (("long", "pendulum"), ("long", "pitching"), ("long", "axial spring"),
-                          ("lat", "pendulum"), ("lat", "rolling")):
-        m = ana.find(subset, label)
-        if m is not None:
-            name = {"long": "longitudinal", "lat": "lateral"}[subset]
-            print(f"    {name:12s} {label:13s} period {m.period:7.2f} s  damping {m.zeta:.3f}")
-    results = run_evaluations(["passive", "lqr", policy], "tiny")
-    md = write_report(results, args.out, "aerostat-gym demo", "aerostat-gym demo")
-    print()
-    print(comparison_table(results, "recover"))
-    print(f"\nreport: {md} ({time.perf_counter() - t0:.0f} s)")
-    return 0
-
-
-def _shipped(path: str) -> str:
-    if Path(path).is_file():
-        return path
-    raise FileNotFoundError(f"policy not found: {path} (run from the repository root, where "
-                            "agents/ holds the shipped policy, or pass --policy PATH.zip)")
-
-
-def plot_training_curve(run: str | Path, out: str | Path) -> Path:
-    """Suite score against environment steps and wall time from a run's evaluations.json."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    hist = json.loads((Path(run) / "evaluations.json").read_text())
-    steps = [h["timesteps"] for h in hist]
-    score = [h["score"] for h in hist]
-    fig, ax = plt.subplots(1, 2, figsize=(9, 3.5))
-    ax[0].plot(steps, score, "o-")
-    ax[0].set_xlabel("environment steps")
-    ax[1].plot([h["wall_time_s"] / 60 for h in hist], score, "o-")
-    ax[1].set_xlabel("wall time [min]")
-    for a in ax:
-        a.set_ylabel("suite score (mean return)")
-        a.grid(alpha=0.3)
-    fig.tight_layout()
-    path = Path(out)
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path

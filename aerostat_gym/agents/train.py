@@ -21,12 +21,14 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..envs.sb3 import sb3_vec_env
 from ..params import dumps_toml
 from ..registration import ENV_ID
+from .evaluate import check_suite, suite_score
+from .sb3io import SB3Policy, save_model, vecnormalize_path
 
 ALGOS = ("ppo", "sac", "td3")
 HYPERPARAMS_DIR = Path("agents/hyperparams")
-VECNORM_SUFFIX = "_vecnormalize.pkl"
 RESERVED = {"n_timesteps", "n_envs", "policy", "normalize", "env_kwargs", "eval_freq",
             "eval_suite", "noise_type", "noise_std", "policy_kwargs"}
 
@@ -66,8 +68,6 @@ def _algorithm(algo: str):
 def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize):
     """The SB3 VecEnv over one compiled batch, wrapped in VecMonitor and VecNormalize."""
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
-
-    from ..envs import sb3_vec_env
 
     venv = VecMonitor(sb3_vec_env(n_envs, seed=seed, **env_kwargs))
     if normalize:
@@ -123,9 +123,6 @@ def suite_eval_callback(suite: str, freq: int, run: Path):
     ``evaluations.json`` and saves the best-scoring model (with its statistics) as
     ``best_model.zip``; it scores once more at the end of training."""
     from stable_baselines3.common.callbacks import BaseCallback
-
-    from .baselines import SB3Policy
-    from .evaluate import check_suite, suite_score
 
     check_suite(suite)
 
@@ -201,27 +198,6 @@ def _load_vecnormalize_into(checkpoint: Path, venv):
     return venv
 
 
-def vecnormalize_path(model_path: Path) -> Path:
-    """Where the VecNormalize statistics of a saved model live: checkpoints use SB3's
-    ``<prefix>_vecnormalize_<steps>_steps.pkl``; our models ``<stem>_vecnormalize.pkl``."""
-    model_path = Path(model_path)
-    stem = model_path.stem
-    if stem.endswith("_steps") and "_" in stem:
-        prefix, steps = stem.rsplit("_", 2)[0], stem.rsplit("_", 2)[1]
-        return model_path.with_name(f"{prefix}_vecnormalize_{steps}_steps.pkl")
-    return model_path.with_name(stem + VECNORM_SUFFIX)
-
-
-def save_model(model, path: Path) -> None:
-    """Save the model and, if it trains on a VecNormalize, its statistics beside it."""
-    from stable_baselines3.common.vec_env import VecNormalize
-
-    model.save(str(path))
-    env = model.get_env()
-    if isinstance(env, VecNormalize):
-        env.save(str(vecnormalize_path(path)))
-
-
 def _write_run_files(run, algo, hp, venv, seed, n_envs, timesteps):
     import yaml
 
@@ -235,25 +211,3 @@ def _write_run_files(run, algo, hp, venv, seed, n_envs, timesteps):
         "aerostat_gym": __version__, "python": platform.python_version(), "algo": algo,
         "seed": seed, "n_envs": n_envs, "timesteps": timesteps}, indent=2))
 
-
-def add_train_parser(sub) -> None:
-    p = sub.add_parser("train", help="train a winch-control policy with Stable-Baselines3")
-    p.add_argument("--algo", choices=ALGOS, default="ppo")
-    p.add_argument("--config", help="hyperparameter YAML (default agents/hyperparams/ALGO.yml)")
-    p.add_argument("--timesteps", type=int, help="total environment steps (default: the YAML)")
-    p.add_argument("--n-envs", type=int, help="parallel environments (default: the YAML)")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--run-dir", help="output directory (default runs/train/ALGO_seedS_TIME)")
-    p.add_argument("--resume", help="checkpoint .zip to continue from")
-    p.add_argument("--eval-freq", type=int, help="evaluate on the suite every N steps")
-    p.add_argument("--threads", type=int, help="torch threads (default: torch's)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.set_defaults(func=_train_command)
-
-
-def _train_command(args) -> int:
-    run = train(args.algo, args.config, args.timesteps, args.n_envs, args.seed, args.run_dir,
-                args.resume, not args.no_progress, args.threads, args.eval_freq)
-    print(f"run directory: {run}")
-    print((run / "training_summary.json").read_text())
-    return 0

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..physics.core import rotation_matrix
-from ..simulation import Model
+from ..sim import Model
 
 
 def mechanical_energy(model: Model, x: np.ndarray) -> float:

@@ -16,7 +16,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from ..params import Params, load_params
-from ..simulation import Model, simulate
+from ..sim import Model, simulate
 from .linear import linearize
 from .modes import FIGURE9_MODES, SETS, Sweep, wind_sweep
 from .trim import find_equilibrium

@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..params import Params
-from ..physics.layout import N_INPUTS, U_BRAKE, U_SPEED, StateLayout
-from ..simulation import Model
+from ..physics.state import N_INPUTS, U_BRAKE, U_SPEED, StateLayout
+from ..sim import Model
 from .trim import Equilibrium
 
 

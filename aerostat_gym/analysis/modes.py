@@ -20,7 +20,7 @@ from scipy.optimize import linear_sum_assignment
 
 from ..params import Params, load_params
 from ..physics.core import rotation_matrix
-from ..physics.layout import StateLayout
+from ..physics.state import StateLayout
 from .linear import Decoupled, LinearModel, decouple, linearize
 from .trim import Equilibrium, find_equilibrium
 
@@ -336,9 +336,14 @@ def track(tables: list[list[Mode]], ctx_list: list[ModeContext], freq_weight: fl
 
     Parameters
     ----------
-    tables : modal table at each sweep point. ctx_list : the matching contexts.
-    freq_weight : weight of the frequency jump in the matching cost. min_mac : a match needs at
-        least this MAC; otherwise the mode starts a new track.
+    tables : list of list of Mode
+        Modal table at each sweep point.
+    ctx_list : list of ModeContext
+        The matching contexts.
+    freq_weight : float
+        Weight of the frequency jump in the matching cost.
+    min_mac : float
+        A match needs at least this MAC; otherwise the mode starts a new track.
 
     Returns
     -------

@@ -150,7 +150,7 @@ def default_knobs(params: Params | None = None) -> list[Knob]:
 # --- evaluation ----------------------------------------------------------------------------------
 
 
-def evaluate(params: Params, speeds=DAMPING_SPEEDS, period_speed: float = 1.0) -> dict:
+def stability_figures(params: Params, speeds=DAMPING_SPEEDS, period_speed: float = 1.0) -> dict:
     """Table 2 periods at ``period_speed`` and the damping/stability summary over ``speeds``.
 
     Returns
@@ -187,19 +187,19 @@ def sensitivity_table(params: Params | None = None, knobs: list[Knob] | None = N
 
     Returns
     -------
-    {"baseline": evaluate(params), "rows": [...]}: per knob its range and source, and for each
+    {"baseline": stability_figures(params), "rows": [...]}: per knob its range and source, and for each
     end the Table 2 periods with their % change from the baseline, the smallest damping ratio
     and where it occurs, stability. Rows are sorted by the largest |% change| of any period.
     """
     p = params or load_params()
     knobs = default_knobs(p) if knobs is None else knobs
-    base = evaluate(p, speeds)
+    base = stability_figures(p, speeds)
     rows = []
     for k in knobs:
         row = {"knob": k.key, "label": k.label, "status": k.status, "unit": k.unit,
                "baseline": k.get(p), "low": k.low, "high": k.high, "source": k.source}
         for end in ("low", "high"):
-            res = evaluate(k.put(p, getattr(k, end)), speeds)
+            res = stability_figures(k.put(p, getattr(k, end)), speeds)
             row[end + "_result"] = res
             if "error" not in res:
                 row[end + "_pct"] = {key: 100 * (res[key] - base[key]) / base[key] for key in PERIOD_KEYS}
@@ -283,6 +283,6 @@ def lateral_pendulum_fixes(params: Params | None = None, targets=(TABLE2["lat_pe
             row = {"knob": k.key, "label": k.label, "target_s": t, "value": v,
                    "baseline": k.get(p), "in_range": v is not None and k.low <= v <= k.high}
             if v is not None:
-                row["result"] = evaluate(k.put(p, v))
+                row["result"] = stability_figures(k.put(p, v))
             rows.append(row)
     return rows

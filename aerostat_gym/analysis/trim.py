@@ -19,7 +19,7 @@ import numpy as np
 from ..params import Params, load_params
 from ..physics.core import rotation_matrix
 from ..physics.wind import pack_wind
-from ..simulation import Model
+from ..sim import Model
 
 REL_TOL = 1e-9
 
@@ -199,7 +199,7 @@ def trim_summary(model: Model, x: np.ndarray, wind_speed: float) -> dict:
         "roll_deg": math.degrees(phi),
         "yaw_deg": math.degrees(psi),
         "top_tension_N": top,
-        "bottom_tension_N": bottom,
+        "winch_tension_N": bottom,
         "min_tension_N": float(model.tensions(x).min()),
         "elevation_at_winch_deg": elevation,
         "tether_length_m": float(x[lay.winch_length]),

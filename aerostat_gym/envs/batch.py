@@ -9,14 +9,17 @@ import math
 
 import numpy as np
 
-from ..physics.core import work_size
-from ..physics.layout import P_SIZE, StateLayout
-from ..physics.wind import W_SIZE
+from ..physics.integrators import scheme
+from ..physics.packing import P_SIZE
+from ..physics.state import StateLayout, work_size
+from ..physics.wind import W_SIZE, mean_wind, set_advection
+from ..sim import Model
+from ..sim.events import RUNNING
 from . import kernel as K
-from . import spaces
-from .task import (
+from . import reward, spaces
+from .config import TaskConfig
+from .episodes import (
     DEFAULT_HORIZON,
-    TaskConfig,
     TrimTable,
     field_length_needed,
     sample_episode,
@@ -53,22 +56,24 @@ class EnvBatch:
         self.horizon = float(horizon) if horizon else DEFAULT_HORIZON
         self.bank = self._bank()
         self.cfg = self._config(params)
-        self.X = np.zeros((N, S))
-        self.Xp = np.zeros((N, S))
-        self.XT = np.zeros((N, S))
-        self.TT = np.zeros(N)
-        self.T = np.zeros(N)
-        self.A = np.zeros(N)
-        self.AP = np.zeros(N)
-        self.BR = np.zeros(N, dtype=np.bool_)
+        # per-slot arrays, one row per environment
+        self.state = np.zeros((N, S))  # simulator state (StateLayout order)
+        self.state_prev = np.zeros((N, S))  # state at the start of the step (restored on failure)
+        self.trim_state = np.zeros((N, S))  # the episode's trim
+        self.trim_tension = np.zeros(N)  # winch tension at the trim [N]
+        self.time = np.zeros(N)  # episode time [s]
+        self.action = np.zeros(N)  # action of the step in [-1, 1]
+        self.action_prev = np.zeros(N)
+        self.braked = np.zeros(N, dtype=np.bool_)  # the brake holds the drum
         self._clipped = np.zeros(N, dtype=np.bool_)
-        self.P = np.zeros((N, P_SIZE))
-        self.WP = np.zeros((N, W_SIZE))
-        self.KF = np.zeros(N, dtype=np.int64)
-        self.W = np.zeros((N, work_size(params.tether.n_elements)))
-        self.OBS = np.zeros((N, self.obs_dim), dtype=np.float32)
-        self.TERMS = np.zeros((N, len(spaces.REWARD_TERMS)))
-        self.CODE = np.zeros(N, dtype=np.int64)
+        self.packed = np.zeros((N, P_SIZE))  # packed parameters (randomised per episode)
+        self.wind = np.zeros((N, W_SIZE))  # packed wind vector (mean, gust, field grid)
+        self.field_index = np.zeros(N, dtype=np.int64)  # bank field read by the slot
+        self.work = np.zeros((N, work_size(params.tether.n_elements)))
+        self.obs = np.zeros((N, self.obs_dim), dtype=np.float32)
+        self.terms = np.zeros((N, len(reward.REWARD_TERMS)))  # default reward terms
+        self.code = np.zeros(N, dtype=np.int64)  # outcome code of the last step
+        self.peak = np.zeros(N)  # largest element tension over the last step [N]
         self.episodes: list = [None] * N
         self.scale = spaces.scales()
         self.low64 = self.obs_low[:spaces.N_OBS].astype(float)
@@ -95,10 +100,9 @@ class EnvBatch:
     def _config(self, params) -> np.ndarray:
         t, w = self.task, params.winch
         cfg = np.zeros(K.C_SIZE)
+        sim = params.simulation
+        cfg[:K.C_DT] = scheme(t.integrator, sim.rk4_safety, sim.semi_implicit_dt)
         cfg[K.C_DT] = t.control_step
-        cfg[K.C_SEMI_IMPLICIT] = 1.0 if t.integrator == "semi-implicit" else 0.0
-        cfg[K.C_SI_DT] = params.simulation.semi_implicit_dt
-        cfg[K.C_RK4_SAFETY] = params.simulation.rk4_safety
         cfg[K.C_GROUND] = params.aerostat.diameter
         cfg[K.C_BRAKE_SPEED] = w.brake_speed
         cfg[K.C_HOLD_SPEED] = w.brake_hold_speed
@@ -111,23 +115,51 @@ class EnvBatch:
     # --- episodes --------------------------------------------------------------------------
 
     def reset_one(self, i: int, rng: np.random.Generator, options: dict | None = None) -> dict:
-        """Start a new episode in slot i; fills OBS[i] and returns the episode info."""
+        """Start a new episode in slot i; fills obs[i] and returns the episode info."""
         ep = sample_episode(self.task, self.trims, self.bank.shape, self.horizon, rng, options)
-        self.X[i] = ep.x0
-        self.XT[i] = ep.x_trim
-        self.TT[i] = ep.tension_trim
-        self.P[i] = ep.p
-        self.WP[i] = ep.wp
-        self.KF[i] = ep.field_index
-        self.T[i] = 0.0
-        self.A[i] = self.AP[i] = 0.0
-        self.BR[i] = False
-        self.CODE[i] = spaces.RUNNING
+        self.state[i] = ep.x0
+        self.trim_state[i] = ep.x_trim
+        self.trim_tension[i] = ep.tension_trim
+        self.packed[i] = ep.p
+        self.wind[i] = ep.wp
+        self.field_index[i] = ep.field_index
+        self.time[i] = 0.0
+        self.action[i] = self.action_prev[i] = 0.0
+        self.braked[i] = False
+        self.code[i] = RUNNING
+        self.peak[i] = 0.0
         self.episodes[i] = ep
-        K.observe(self.X[i], 0.0, self.P[i], self.WP[i], self.bank[self.KF[i]], self.W[i],
-                  self.cfg, self.XT[i], self.TT[i], self.scale, self.low64, self.high64,
-                  self.OBS[i])
+        self.observe(i)
         return dict(ep.info)
+
+    def observe(self, i: int) -> None:
+        """Recompute obs[i] from slot i's state (no noise)."""
+        K.observe(self.state[i], self.time[i], self.packed[i], self.wind[i],
+                  self.bank[self.field_index[i]], self.work[i], self.cfg, self.trim_state[i],
+                  self.trim_tension[i], self.scale, self.low64, self.high64, self.obs[i])
+
+    #: Per-slot arrays that make up the simulator state of one environment.
+    SLOT_ARRAYS = ("state", "trim_state", "trim_tension", "time", "action", "action_prev",
+                   "braked", "packed", "wind", "field_index", "obs", "terms", "code", "peak")
+
+    def get_slot(self, i: int) -> dict:
+        """A copy of everything that determines slot i's future (see :meth:`set_slot`)."""
+        out = {name: np.copy(getattr(self, name)[i]) for name in self.SLOT_ARRAYS}
+        out["episode"] = self.episodes[i]
+        return out
+
+    def set_slot(self, i: int, saved: dict) -> None:
+        """Restore slot i from :meth:`get_slot`'s output: stepping on from it reproduces the
+        original run bit for bit (the work arrays are recomputed by every step)."""
+        missing = sorted(set(self.SLOT_ARRAYS) - set(saved))
+        if missing:
+            raise ValueError(f"simulator state lacks {missing}")
+        if np.shape(saved["state"]) != self.state[i].shape:
+            raise ValueError(f"simulator state has shape {np.shape(saved['state'])}, this "
+                             f"environment's is {self.state[i].shape}")
+        for name in self.SLOT_ARRAYS:
+            getattr(self, name)[i] = saved[name]
+        self.episodes[i] = saved["episode"]
 
     def set_actions(self, actions) -> np.ndarray:
         """Validate and store actions, shape (N,) or (N, 1): NaN/inf is an ActionError,
@@ -146,53 +178,49 @@ class EnvBatch:
         if scalar:
             v = float(a[0])
             self._clipped[0] = abs(v) > 1.0
-            self.A[0] = min(max(v, -1.0), 1.0)
+            self.action[0] = min(max(v, -1.0), 1.0)
         else:
             np.greater(np.abs(a), 1.0, out=self._clipped)
-            np.clip(a, -1.0, 1.0, out=self.A)
+            np.clip(a, -1.0, 1.0, out=self.action)
         return self._clipped
+
+    def _arrays(self) -> tuple:
+        return (self.state, self.state_prev, self.time, self.action, self.action_prev,
+                self.braked, self.packed, self.wind, self.bank, self.field_index, self.work,
+                self.cfg, self.trim_state, self.trim_tension, self.scale, self.low64, self.high64,
+                self.obs, self.terms, self.code, self.peak)
 
     def step(self, active: np.ndarray | None = None) -> None:
         """Advance every active environment one control step with the stored actions."""
         if active is None and self.num_envs == 1:
-            K.step_serial(self.X, self.Xp, self.T, self.A, self.AP, self.BR, self.P, self.WP,
-                          self.bank, self.KF, self.W, self.cfg, self.XT, self.TT, self.scale,
-                          self.low64, self.high64, self.OBS, self.TERMS, self.CODE)
+            K.step_serial(*self._arrays())
             return
         if active is None:
             active = np.ones(self.num_envs, dtype=np.bool_)
-        K.step_parallel(active, self.X, self.Xp, self.T, self.A, self.AP, self.BR, self.P,
-                        self.WP, self.bank, self.KF, self.W, self.cfg, self.XT, self.TT,
-                        self.scale, self.low64, self.high64, self.OBS, self.TERMS, self.CODE)
+        K.step_parallel(active, *self._arrays())
 
     def add_noise(self, i: int, rng: np.random.Generator) -> None:
         """Gaussian sensor noise of std ``obs_noise`` (in scaled units) on the standard channels."""
         sigma = self.task.obs_noise
         if sigma > 0.0:
-            o = self.OBS[i, :spaces.N_OBS]
+            o = self.obs[i, :spaces.N_OBS]
             o += rng.normal(0.0, sigma, o.shape).astype(np.float32)
             np.clip(o, self.obs_low[:spaces.N_OBS], self.obs_high[:spaces.N_OBS], out=o)
 
     def snapshot(self, i: int) -> dict:
         """Physical quantities of environment i for rendering and diagnostics."""
-        from ..simulation import Model
-
         ep = self.episodes[i]
-        x = self.X[i].copy()
-        model = Model(ep.params, (self.WP[i], self.bank[self.KF[i]]))
+        x = self.state[i].copy()
+        model = Model(ep.params, (self.wind[i], self.bank[self.field_index[i]]))
         lay = self.layout
-        return {"time": float(self.T[i]), "state": x, "nodes": model.node_positions(x),
-                "cm_pos": x[lay.cm_pos], "euler": x[lay.euler], "trim_cm": self.XT[i][lay.cm_pos],
-                "tension": model.end_tensions(x, float(self.T[i]))[1],
+        return {"time": float(self.time[i]), "state": x, "nodes": model.node_positions(x),
+                "cm_pos": x[lay.cm_pos], "euler": x[lay.euler],
+                "trim_cm": self.trim_state[i][lay.cm_pos],
+                "tension": model.end_tensions(x, float(self.time[i]))[1],
                 "length": float(x[lay.winch_length]), "reel_speed": float(x[lay.winch_speed]),
                 "wind_speed": ep.wind_speed, "params": ep.params}
 
 
 def _advection_factor(params, turb) -> float:
     """U_a / U_ref for the configured mean profile (1 for the paper's uniform wind)."""
-    from ..physics.wind import pack_wind, set_advection
-
-    w = params.wind
-    wp = pack_wind(w.profile, 1.0, w.direction_deg, w.reference_height, w.shear_exponent,
-                   w.roughness_length)
-    return set_advection(wp, turb.reference_height, 0.0)
+    return set_advection(mean_wind(params.wind, 1.0), turb.reference_height, 0.0)

@@ -8,17 +8,17 @@ import math
 import gymnasium as gym
 import numpy as np
 
-from . import spaces
+from ..sim.events import FIELD_END, NONFINITE, OUTCOMES, RUNNING
+from . import reward
 from .batch import EnvBatch
-from .task import TaskConfig
+from .config import TaskConfig
+from .render import Frame, Renderer
 
 RENDER_MODES = ["human", "rgb_array"]
 
 
 def frame(s: dict):
     """The renderer's Frame from an :meth:`EnvBatch.snapshot` (the episode's mean wind)."""
-    from .render import Frame
-
     d = math.radians(s["params"].wind.direction_deg)
     wind = s["wind_speed"] * np.array([math.cos(d), math.sin(d), 0.0])
     return Frame(time=s["time"], nodes=s["nodes"], cm_pos=s["cm_pos"], euler=s["euler"],
@@ -30,7 +30,7 @@ class TetheredAerostatEnv(gym.Env):
     """
     ## Description
 
-    A streamlined aerostat (Aeros Flightcam class, 250 m^3) flies on a 300 m viscoelastic
+    A streamlined aerostat (Aeros Flightcam class, 519 m^3) flies on a 300 m viscoelastic
     tether from a ground winch, after Lambert and Nahon, "Stability Analysis of a Tethered
     Aerostat" (AIAA 2002-4497): a lumped-mass tether of n elements (Morison drag, gravity,
     tension-only viscoelastic elements) joined at the confluence point to a rigid 6-DOF
@@ -39,8 +39,8 @@ class TetheredAerostatEnv(gym.Env):
 
     Frames and signs: inertial X, Y, Z with Z up and the winch at the origin; the mean wind
     blows along +X, so at trim the aerostat flies downwind (X > 0) with its nose into the wind
-    (yaw psi = pi). Attitude is the Z-Y-X Euler triple (roll phi, pitch theta positive nose
-    up, yaw psi); body rates p, q, r about the body x (nose), y, z axes. A positive reel speed
+    (yaw psi = pi). Attitude is the Z-Y-X Euler triple (roll phi, pitch theta, yaw psi;
+    theta < 0 is nose up, so a positive pitch observation is nose down); body rates p, q, r about the body x (nose), y, z axes. A positive reel speed
     pays line out. SI units throughout.
 
     ## Action Space
@@ -63,7 +63,7 @@ class TetheredAerostatEnv(gym.Env):
     |---|---|---|---|
     | 0-2 | aerostat CM position minus the episode's trim (X, Y, Z) | m | 10 |
     | 3-5 | aerostat CM velocity (X, Y, Z) | m/s | 2 |
-    | 6-8 | roll, pitch, yaw minus trim (yaw wrapped to [-pi, pi]) | rad | 0.05 |
+    | 6-8 | roll, pitch, yaw minus trim (yaw wrapped to [-pi, pi]; pitch > 0 nose down) | rad | 0.05 |
     | 9-11 | body rates p, q, r | rad/s | 0.02 |
     | 12 | winch tension (load cell) | N | 1e4 |
     | 13 | winch tension minus its trim value | N | 1e3 |
@@ -74,7 +74,7 @@ class TetheredAerostatEnv(gym.Env):
     ``obs_noise`` adds Gaussian noise of that standard deviation (in scaled units) to these
     channels. ``observation="full"`` appends, unscaled and privileged, the episode's mean
     wind speed [m/s] and the full simulator state minus trim (6 n + 8 entries in
-    :class:`aerostat_gym.physics.layout.StateLayout` order; 68 for n = 10): 88 channels.
+    :class:`aerostat_gym.physics.state.StateLayout` order; 68 for n = 10): 88 channels.
 
     ## Rewards
 
@@ -86,6 +86,10 @@ class TetheredAerostatEnv(gym.Env):
     peak element tension over the step and the winch's safe working load; termination ``-w``
     on a terminating step; length ``-w dlength^2`` (channel 14), which keeps the winch near its
     trim length on average. Defaults: ``aerostat_gym.envs.DEFAULT_WEIGHTS``.
+
+    The reward is swappable (:mod:`aerostat_gym.envs.reward`): ``reward_fn=f`` replaces it by
+    ``f(obs, action, info)``, called after each step with the new observation, the applied
+    action and the step's info (which keeps the default terms and ``info["peak_tension"]``).
 
     ## Starting State
 
@@ -131,7 +135,8 @@ class TetheredAerostatEnv(gym.Env):
       the estimated parameters in ``aerostat_gym.envs.task.DEFAULT_RANDOMIZATION``; each
       episode re-trims for its drawn parameters (a few ms per reset).
     - ``obs_noise=0.0``: sensor noise std in scaled units. ``reward_weights=None``: dict of
-      weights by term name. ``observation="standard"`` or ``"full"``.
+      weights by term name. ``reward_fn=None``: a user reward ``f(obs, action, info) -> float``.
+      ``observation="standard"`` or ``"full"``.
     - ``wind_bank_size=8``, ``wind_bank_seed=0``: the shared turbulence bank.
     - ``render_mode=None``: "rgb_array" (an (480, 800, 3) frame: side view x-z with the tether,
       hull, fins, wind arrow and tension readout, plus a top view x-y) or "human".
@@ -164,40 +169,42 @@ class TetheredAerostatEnv(gym.Env):
         self._batch.add_noise(0, self.np_random)
         if self.render_mode == "human":
             self.render()
-        return self._batch.OBS[0].copy(), info
+        return self._batch.obs[0].copy(), info
 
     def step(self, action):
         b = self._batch
         clipped = b.set_actions(action)
         b.step()
         b.add_noise(0, self.np_random)
-        terms = b.TERMS[0]
-        code = int(b.CODE[0])
-        info = {"reward_" + k: terms[j] for j, k in enumerate(spaces.REWARD_TERMS)}
+        terms = b.terms[0]
+        code = int(b.code[0])
+        info = {"reward_" + k: terms[j] for j, k in enumerate(reward.REWARD_TERMS)}
         info["action_clipped"] = bool(clipped[0])
-        info["time"] = b.T[0]
+        info["time"] = b.time[0]
+        info["peak_tension"] = b.peak[0]
         terminated = truncated = False
-        if code != spaces.RUNNING:
-            reason = spaces.OUTCOMES[code]
-            if code == spaces.FIELD_END:
+        if code != RUNNING:
+            reason = OUTCOMES[code]
+            if code == FIELD_END:
                 truncated = True
                 info["truncation"] = reason
             else:
                 terminated = True
                 info["termination"] = reason
-                if code == spaces.NONFINITE:
+                if code == NONFINITE:
                     info["failure"] = reason
         if self.render_mode == "human":
             self.render()
-        return b.OBS[0].copy(), float(terms.sum()), terminated, truncated, info
+        obs = b.obs[0].copy()
+        fn = self.task.reward_fn
+        r = float(terms.sum()) if fn is None else reward.custom_reward(fn, obs, b.action[0], info)
+        return obs, r, terminated, truncated, info
 
     def render(self):
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode="
                             "'rgb_array' or 'human' to gym.make")
             return None
-        from .render import Renderer
-
         if self._renderer is None:
             self._renderer = Renderer(self._batch.params, self.render_mode,
                                       fps=self.metadata["render_fps"])
@@ -213,7 +220,24 @@ class TetheredAerostatEnv(gym.Env):
     @property
     def state(self) -> np.ndarray:
         """The full simulator state (copy; StateLayout order)."""
-        return self._batch.X[0].copy()
+        return self._batch.state[0].copy()
+
+    def get_state(self) -> dict:
+        """Everything that determines the rest of the episode: the simulator slot (state,
+        trim, packed parameters, wind, clock, winch brake and last action), the last
+        observation, and the random generator's state (observation noise). Pass it to
+        :meth:`set_state` to return here: the steps that follow are bit-identical."""
+        saved = self._batch.get_slot(0)
+        saved["np_random"] = self.np_random.bit_generator.state
+        return saved
+
+    def set_state(self, saved: dict) -> np.ndarray:
+        """Restore a :meth:`get_state` snapshot; returns the observation saved with it."""
+        if not isinstance(saved, dict) or "np_random" not in saved:
+            raise ValueError("set_state expects a dict from get_state()")
+        self._batch.set_slot(0, saved)
+        self.np_random.bit_generator.state = saved["np_random"]
+        return self._batch.obs[0].copy()
 
     @property
     def episode(self):

@@ -3,7 +3,11 @@ observation, reward terms and episode-end checks in one call, for one environmen
 
 The single environment and the vector environment call the same per-environment function
 :func:`_step_one` (the vector env through :func:`step_parallel`, a ``prange`` over
-environments), so environment i of a batch reproduces a single environment bit for bit.
+environments), so environment i of a batch reproduces a single environment bit for bit. The
+integration is the simulator's own interval advance
+(:func:`aerostat_gym.physics.integrators.advance_interval`) and the episode-end check the
+simulator's (:func:`aerostat_gym.sim.events.step_outcome`): nothing here is a second copy of
+the simulator.
 """
 
 from __future__ import annotations
@@ -14,27 +18,50 @@ import numpy as np
 from numba import njit, prange
 
 from ..physics.core import FASTMATH, evaluate_tether
-from ..physics.integrators import NONFINITE, rk4_advance, rk4_step, si_advance
-from ..physics.layout import P_EA, P_MU, P_NEL, P_STRENGTH, P_W_LMAX, P_W_LMIN, P_W_VMAX
-from ..physics.outputs import winch_end_tension
+from ..physics.integrators import (
+    NONFINITE,
+    SCHEME_RK4_SAFETY,
+    SCHEME_SEMI_IMPLICIT,
+    SCHEME_SI_DT,
+    SCHEME_SIZE,
+    SCHEME_STEP,
+    advance_interval,
+)
+from ..physics.outputs import winch_tension
+from ..physics.packing import P_NEL, P_W_VMAX
+from ..physics.state import (
+    S_LENGTH,
+    S_P,
+    S_PHI,
+    S_PSI,
+    S_REEL,
+    S_THETA,
+    S_VX,
+    S_X,
+    aerostat_offset,
+)
 from ..physics.wind import W_UREF, air_velocity
-from ..winch import brake_rule
+from ..sim import events as E
+from ..sim.winch import brake_rule
+from . import reward as R
 from . import spaces as S
 
 # --- configuration vector shared by all environments of a batch -----------------------------
-C_DT = 0  # control step [s]
-C_SEMI_IMPLICIT = 1  # 1: semi-implicit integrator, 0: RK4
-C_SI_DT = 2  # largest semi-implicit step [s]
-C_RK4_SAFETY = 3  # fraction of the RK4 stability bound
-C_GROUND = 4  # ground-strike height of the CM [m] (one hull diameter)
-C_BRAKE_SPEED = 5  # set-points below this engage the brake [m/s]
-C_HOLD_SPEED = 6  # the brake clamps the drum below this reel speed [m/s]
-C_SWL = 7  # safe working load [N]
-C_FULL = 8  # 1: append the privileged full state to the observation
-C_HORIZON = 9  # the turbulence field covers up to this time [s]
-C_WEIGHTS = 10  # reward weights in spaces.REWARD_TERMS order
-C_SIZE = C_WEIGHTS + len(S.REWARD_TERMS)
-LENGTH_TOL = 1e-3  # [m] the winch's stopping profile keeps L inside its limits to << this
+# It starts with the integration scheme vector of advance_interval (SCHEME_* entries), so the
+# configuration itself is passed as the scheme.
+C_SEMI_IMPLICIT = SCHEME_SEMI_IMPLICIT
+C_STEP = SCHEME_STEP  # fixed integration step [s] (0: the scheme's own)
+C_RK4_SAFETY = SCHEME_RK4_SAFETY
+C_SI_DT = SCHEME_SI_DT
+C_DT = SCHEME_SIZE  # control step [s]
+C_GROUND = C_DT + 1  # ground-strike height of the CM [m] (one hull diameter)
+C_BRAKE_SPEED = C_DT + 2  # set-points below this engage the brake [m/s]
+C_HOLD_SPEED = C_DT + 3  # the brake clamps the drum below this reel speed [m/s]
+C_SWL = C_DT + 4  # safe working load [N]
+C_FULL = C_DT + 5  # 1: append the privileged full state to the observation
+C_HORIZON = C_DT + 6  # the turbulence field covers up to this time [s]
+C_WEIGHTS = C_DT + 7  # reward weights in reward.REWARD_TERMS order
+C_SIZE = C_WEIGHTS + len(R.REWARD_TERMS)
 
 _JIT = {"cache": True, "error_model": "numpy", "fastmath": FASTMATH}
 
@@ -47,96 +74,52 @@ def _wrap(a):
 
 @njit(**_JIT)
 def observe(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs):
-    """Fill ``obs`` (float32) for state x at time t; returns the winch tension [N]."""
+    """Fill ``obs`` (float32) for state x at time t; returns the winch tension [N].
+
+    Channels in :data:`aerostat_gym.envs.spaces.CHANNELS` order: attitude deviations are
+    theta - theta_trim etc. unchanged in sign (theta < 0 is nose up).
+    """
     n = int(p[P_NEL])
-    o = 6 * (n - 1)
+    o = aerostat_offset(n)
     evaluate_tether(t, x, p, wp, wf, w)
-    T_w = winch_end_tension(x, p, w)
-    ax, ay, az = air_velocity(x[o], x[o + 1], x[o + 2], t, wp, wf)
+    T_w = winch_tension(x, p, w)
+    ax, ay, az = air_velocity(x[o + S_X], x[o + S_X + 1], x[o + S_X + 2], t, wp, wf)
     raw = np.empty(S.N_OBS)
     for k in range(3):
-        raw[k] = x[o + k] - x_trim[o + k]  # CM position minus trim
-        raw[3 + k] = x[o + 3 + k]  # CM velocity
-        raw[9 + k] = x[o + 9 + k]  # body rates
-    raw[6] = x[o + 6] - x_trim[o + 6]
-    raw[7] = x[o + 7] - x_trim[o + 7]
-    raw[8] = _wrap(x[o + 8] - x_trim[o + 8])
-    raw[12] = T_w
-    raw[13] = T_w - T_trim
-    raw[14] = x[o + 12] - x_trim[o + 12]
-    raw[15] = x[o + 13]
-    raw[16], raw[17], raw[18] = ax, ay, az
+        raw[S.OBS_DX + k] = x[o + S_X + k] - x_trim[o + S_X + k]  # CM position minus trim
+        raw[S.OBS_VX + k] = x[o + S_VX + k]  # CM velocity
+        raw[S.OBS_P + k] = x[o + S_P + k]  # body rates
+    raw[S.OBS_DROLL] = x[o + S_PHI] - x_trim[o + S_PHI]
+    raw[S.OBS_DPITCH] = x[o + S_THETA] - x_trim[o + S_THETA]
+    raw[S.OBS_DYAW] = _wrap(x[o + S_PSI] - x_trim[o + S_PSI])
+    raw[S.OBS_TENSION] = T_w
+    raw[S.OBS_DTENSION] = T_w - T_trim
+    raw[S.OBS_DLENGTH] = x[o + S_LENGTH] - x_trim[o + S_LENGTH]
+    raw[S.OBS_REEL_SPEED] = x[o + S_REEL]
+    raw[S.OBS_WIND_X], raw[S.OBS_WIND_Y], raw[S.OBS_WIND_Z] = ax, ay, az
     for k in range(S.N_OBS):
         obs[k] = min(max(raw[k] / scale[k], lo[k]), hi[k])
     if cfg[C_FULL] != 0.0:
         lim = S.FULL_STATE_LIMIT
-        obs[S.N_OBS] = min(wp[W_UREF], lim)
+        obs[S.OBS_FULL_WIND] = min(wp[W_UREF], lim)
         for i in range(x.size):
             d = x[i] - x_trim[i]
-            if i == o + 8:
+            if i == o + S_PSI:
                 d = _wrap(d)
-            obs[S.N_OBS + 1 + i] = min(max(d, -lim), lim)
+            obs[S.OBS_FULL_STATE + i] = min(max(d, -lim), lim)
     return T_w
-
-
-@njit(**_JIT)
-def _advance(x, t, u, p, wp, wf, w, cfg, stats):
-    """Integrate one control interval with the configured integrator; returns its status."""
-    n = int(p[P_NEL])
-    dt = cfg[C_DT]
-    if cfg[C_SEMI_IMPLICIT] != 0.0:
-        h_max = cfg[C_SI_DT]
-    else:  # the RK4 bound tightens as the tether is reeled in (shorter elements)
-        h_max = rk4_step(p[P_EA], p[P_MU], x[6 * (n - 1) + 12] / n, cfg[C_RK4_SAFETY], n)
-    nsteps = max(1, int(math.ceil(dt / h_max - 1e-9)))
-    h = dt / nsteps
-    if cfg[C_SEMI_IMPLICIT] != 0.0:
-        return si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats)
-    return rk4_advance(x, t, h, nsteps, u, p, wp, wf, w, stats)
-
-
-@njit(**_JIT)
-def _outcome(x, t, p, peak, cfg):
-    o = 6 * (int(p[P_NEL]) - 1)
-    if peak > p[P_STRENGTH]:
-        return S.TETHER_BREAK
-    if x[o + 2] < cfg[C_GROUND]:
-        return S.GROUND_STRIKE
-    L = x[o + 12]
-    if L < p[P_W_LMIN] - LENGTH_TOL or L > p[P_W_LMAX] + LENGTH_TOL:
-        return S.LENGTH_LIMIT
-    if t > cfg[C_HORIZON] + 1e-9:
-        return S.FIELD_END
-    return S.RUNNING
-
-
-@njit(**_JIT)
-def _rewards(obs, a, a_prev, peak, code, cfg, terms):
-    wt = cfg[C_WEIGHTS:]
-    # blow-by: horizontal motion only (the winch's own reeling moves the aerostat vertically)
-    terms[0] = -wt[0] * (obs[0] ** 2 + obs[1] ** 2)
-    terms[1] = -wt[1] * (obs[3] ** 2 + obs[4] ** 2)
-    terms[2] = -wt[2] * obs[7] ** 2
-    terms[3] = -wt[3] * obs[10] ** 2
-    terms[4] = -wt[4] * a * a
-    terms[5] = -wt[5] * (a - a_prev) ** 2
-    terms[6] = -wt[6] * max(0.0, peak / cfg[C_SWL] - 1.0)
-    ends = code != S.RUNNING and code != S.FIELD_END
-    terms[7] = -wt[7] if ends else 0.0
-    terms[8] = -wt[8] * obs[14] ** 2
 
 
 @njit(**_JIT)
 def _step_one(x, x_prev, t, a, a_prev, braked, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi,
               obs, terms):
-    """One control step of one environment; returns (outcome code, brake state).
+    """One control step of one environment; returns (outcome code, brake state, peak tension).
 
     a is the action in [-1, 1] (already clipped): set-point a * v_max through the winch's
     brake rule. On a non-finite state the state is restored to the start of the step, so the
     observation stays finite, and the outcome is NONFINITE.
     """
-    n = int(p[P_NEL])
-    iv = 6 * (n - 1) + 13
+    iv = aerostat_offset(int(p[P_NEL])) + S_REEL
     v_set, brake, v_w = brake_rule(a * p[P_W_VMAX], False, braked, x[iv], p[P_W_VMAX],
                                    cfg[C_BRAKE_SPEED], cfg[C_HOLD_SPEED])
     x[iv] = v_w
@@ -147,41 +130,52 @@ def _step_one(x, x_prev, t, a, a_prev, braked, p, wp, wf, w, cfg, x_trim, T_trim
     stats = np.empty(2)
     stats[0] = 0.0
     stats[1] = np.inf
-    status = _advance(x, t, u, p, wp, wf, w, cfg, stats)
+    status = advance_interval(x, t, cfg[C_DT], u, p, wp, wf, w, cfg, stats)
     t1 = t + cfg[C_DT]
     if status == NONFINITE:
         x[:] = x_prev
         observe(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)
         terms[:] = 0.0
-        terms[7] = -cfg[C_WEIGHTS + 7]  # the termination term only
-        return S.NONFINITE, brake
+        terms[R.R_TERMINATION] = -cfg[C_WEIGHTS + R.R_TERMINATION]  # the termination term only
+        return E.NONFINITE, brake, 0.0
     observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)
-    code = _outcome(x, t1, p, stats[0], cfg)
-    _rewards(obs, a, a_prev, stats[0], code, cfg, terms)
-    return code, brake
+    code = E.step_outcome(x, t1, p, stats[0], cfg[C_GROUND], cfg[C_HORIZON])
+    R.reward_terms(obs, a, a_prev, stats[0], code, cfg[C_WEIGHTS:], cfg[C_SWL], terms)
+    return code, brake, stats[0]
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, parallel=True)
-def step_parallel(active, X, Xp, T, A, AP, BR, P, WP, bank, KF, W, cfg, XT, TT, scale, lo, hi,
-                  OBS, TERMS, CODE):
+def step_parallel(active, state, state_prev, time, action, action_prev, braked, packed, wind,
+                  bank, field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs,
+                  terms, code, peak):
     """Step every environment i with active[i] (parallel over environments)."""
-    for i in prange(X.shape[0]):
+    for i in prange(state.shape[0]):
         if active[i]:
-            code, br = _step_one(X[i], Xp[i], T[i], A[i], AP[i], BR[i], P[i], WP[i], bank[KF[i]],
-                                 W[i], cfg, XT[i], TT[i], scale, lo, hi, OBS[i], TERMS[i])
-            CODE[i] = code
-            BR[i] = br
-            T[i] += cfg[C_DT]
-            AP[i] = A[i]
+            _step_slot(i, state, state_prev, time, action, action_prev, braked, packed, wind,
+                       bank, field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs,
+                       terms, code, peak)
 
 
 @njit(**_JIT)
-def step_serial(X, Xp, T, A, AP, BR, P, WP, bank, KF, W, cfg, XT, TT, scale, lo, hi, OBS, TERMS,
-                CODE):
+def step_serial(state, state_prev, time, action, action_prev, braked, packed, wind, bank,
+                field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs, terms, code,
+                peak):
     """The same step for one environment (index 0), without the thread pool."""
-    code, br = _step_one(X[0], Xp[0], T[0], A[0], AP[0], BR[0], P[0], WP[0], bank[KF[0]], W[0],
-                         cfg, XT[0], TT[0], scale, lo, hi, OBS[0], TERMS[0])
-    CODE[0] = code
-    BR[0] = br
-    T[0] += cfg[C_DT]
-    AP[0] = A[0]
+    _step_slot(0, state, state_prev, time, action, action_prev, braked, packed, wind, bank,
+               field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs, terms, code,
+               peak)
+
+
+@njit(**{**_JIT, "inline": "always"})
+def _step_slot(i, state, state_prev, time, action, action_prev, braked, packed, wind, bank,
+               field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs, terms, code,
+               peak):
+    """Step slot i of the batch arrays and advance its clock and action memory."""
+    c, br, pk = _step_one(state[i], state_prev[i], time[i], action[i], action_prev[i], braked[i],
+                          packed[i], wind[i], bank[field_index[i]], work[i], cfg, trim_state[i],
+                          trim_tension[i], scale, lo, hi, obs[i], terms[i])
+    code[i] = c
+    braked[i] = br
+    peak[i] = pk
+    time[i] += cfg[C_DT]
+    action_prev[i] = action[i]

@@ -3,7 +3,8 @@
 Every observation channel is a physical quantity divided by its scale, clipped to finite bounds.
 Frames and signs (as everywhere in the package, see the README): inertial X, Y, Z with Z up and
 the winch at the origin; the default wind blows along +X; attitude is the Z-Y-X Euler triple
-(roll phi, pitch theta nose up positive, yaw psi; at trim psi = pi, the nose into the wind);
+(roll phi, pitch theta, yaw psi; theta < 0 is nose up, so a positive pitch channel is nose
+down; at trim psi = pi, the nose into the wind);
 body rates p, q, r about the body x (nose), y and z axes; a positive reel speed pays line out.
 """
 
@@ -40,7 +41,8 @@ CHANNELS: tuple[Channel, ...] = (
     _ch("vy", "aerostat CM velocity, Y", "m/s", 2.0, 50.0),
     _ch("vz", "aerostat CM velocity, Z", "m/s", 2.0, 50.0),
     _ch("droll", "roll phi minus trim", "rad", 0.05, np.pi),
-    _ch("dpitch", "pitch theta minus trim (nose up positive)", "rad", 0.05, np.pi),
+    _ch("dpitch", "pitch theta minus trim (theta < 0 is nose up: positive is nose down)", "rad",
+        0.05, np.pi),
     _ch("dyaw", "yaw psi minus trim, wrapped to [-pi, pi]", "rad", 0.05, np.pi),
     _ch("p", "body roll rate", "rad/s", 0.02, 2.0),
     _ch("q", "body pitch rate", "rad/s", 0.02, 2.0),
@@ -58,35 +60,20 @@ N_OBS = len(CHANNELS)
 #: Bound of the privileged full-state part (SI deviations from trim, and the mean wind speed).
 FULL_STATE_LIMIT = 1.0e4
 
-#: Reward terms, in the order of the compiled step's output; info carries "reward_<name>".
-REWARD_TERMS: tuple[str, ...] = ("displacement", "velocity", "pitch", "pitch_rate", "effort",
-                                 "effort_rate", "over_tension", "termination", "length")
-REWARD_DOC = {
-    "displacement": "-w (dx^2 + dy^2), scaled horizontal position channels 0-1 (blow-by)",
-    "velocity": "-w (vx^2 + vy^2), scaled horizontal velocity channels 3-4",
-    "pitch": "-w dpitch^2, scaled channel 7",
-    "pitch_rate": "-w q^2, scaled channel 10",
-    "effort": "-w a^2, a the action in [-1, 1]",
-    "effort_rate": "-w (a - a_previous)^2",
-    "over_tension": "-w max(0, peak element tension / safe working load - 1) over the step",
-    "termination": "-w once, on a terminating step (break, ground strike, length limit, "
-                   "numerical failure)",
-    "length": "-w dlength^2, scaled channel 14: keeps the winch near its trim length on average",
-}
-#: The pendulum (blow-by) oscillation carries the weight: horizontal velocity first, horizontal
-#: displacement next. Pitch and pitch rate are weighted lightly because any reeling excites pitch,
-#: so heavy weights there would make the braked winch unbeatable (measured with the baselines).
-DEFAULT_WEIGHTS = {"displacement": 0.2, "velocity": 1.0, "pitch": 0.1, "pitch_rate": 0.1,
-                   "effort": 0.01, "effort_rate": 0.1, "over_tension": 10.0, "termination": 100.0,
-                   "length": 1.0}
-
-#: Step outcome codes of the compiled step.
-RUNNING, NONFINITE, TETHER_BREAK, GROUND_STRIKE, LENGTH_LIMIT, FIELD_END = range(6)
-#: Reason strings in info["termination"] / info["failure"] / info["truncation"].
-OUTCOMES = {NONFINITE: "nonfinite_state", TETHER_BREAK: "tether_break",
-            GROUND_STRIKE: "ground_strike", LENGTH_LIMIT: "length_limit",
-            FIELD_END: "wind_field_exhausted"}
-
+#: Named channel indices (the position of each channel in CHANNELS; checked by the tests).
+OBS_DX, OBS_DY, OBS_DZ = 0, 1, 2
+OBS_VX, OBS_VY, OBS_VZ = 3, 4, 5
+OBS_DROLL, OBS_DPITCH, OBS_DYAW = 6, 7, 8
+OBS_P, OBS_Q, OBS_R = 9, 10, 11
+OBS_TENSION, OBS_DTENSION = 12, 13
+OBS_DLENGTH, OBS_REEL_SPEED = 14, 15
+OBS_WIND_X, OBS_WIND_Y, OBS_WIND_Z = 16, 17, 18
+#: Channel index by name, e.g. ``OBS_INDEX["dpitch"] == OBS_DPITCH``.
+OBS_INDEX = {c.name: i for i, c in enumerate(CHANNELS)}
+#: ``observation="full"``: index of the episode's mean wind speed, then the first index of the
+#: state deviation x - x_trim (StateLayout order).
+OBS_FULL_WIND = N_OBS
+OBS_FULL_STATE = N_OBS + 1
 
 def observation_table(full_state_size: int = 0) -> list[dict]:
     """Rows (index, name, meaning, unit, scale, low, high) of the observation vector."""
@@ -115,15 +102,3 @@ def bounds(full_state_size: int = 0) -> tuple[np.ndarray, np.ndarray]:
 
 def scales() -> np.ndarray:
     return np.array([c.scale for c in CHANNELS])
-
-
-def weights_vector(weights: dict | None) -> np.ndarray:
-    """Reward weights in REWARD_TERMS order; unknown names or negative/non-finite values raise."""
-    w = dict(DEFAULT_WEIGHTS)
-    for k, v in (weights or {}).items():
-        if k not in w:
-            raise ValueError(f"unknown reward weight {k!r}; known: {list(REWARD_TERMS)}")
-        if not (isinstance(v, (int, float)) and np.isfinite(v) and v >= 0):
-            raise ValueError(f"reward weight {k!r} must be a finite number >= 0, got {v!r}")
-        w[k] = float(v)
-    return np.array([w[k] for k in REWARD_TERMS])

@@ -4,8 +4,8 @@ environments (numba ``prange``; ``NUMBA_NUM_THREADS`` sets the threads).
 - :class:`TetheredAerostatVectorEnv`: a ``gymnasium.vector.VectorEnv``, what
   ``gym.make_vec("TetheredAerostat-v0", num_envs=N, vectorization_mode="vector_entry_point")``
   returns; Gymnasium's autoreset semantics (``NEXT_STEP`` by default, ``SAME_STEP`` on request).
-- :class:`SB3VecEnv`: the same batch as a Stable-Baselines3 ``VecEnv`` (same-step reset with
-  ``info["terminal_observation"]``), so training needs no subprocesses.
+- :func:`aerostat_gym.envs.sb3.sb3_vec_env`: the same batch as a Stable-Baselines3 ``VecEnv``
+  (same-step reset with ``info["terminal_observation"]``), so training needs no subprocesses.
 
 Environment i is seeded with ``seed + i`` and then equals a single ``TetheredAerostat-v0``
 reset with that seed, step for step.
@@ -19,10 +19,12 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from . import spaces
+from ..sim.events import FIELD_END, NONFINITE, OUTCOMES, RUNNING
+from . import reward
 from .batch import EnvBatch
+from .config import TaskConfig
 from .env import frame
-from .task import TaskConfig
+from .render import Renderer
 
 DEFAULT_MAX_EPISODE_STEPS = 600
 
@@ -74,7 +76,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
                 self._rngs[i] = seeding.np_random(seeds[i])[0]
             infos.append((i, self._reset(i, _options_for(opts, i, self.num_envs))))
             self._pending[i] = False
-        return self.batch.OBS.copy(), _stack_infos(infos, self.num_envs)
+        return self.batch.obs.copy(), _stack_infos(infos, self.num_envs)
 
     def step(self, actions):
         b = self.batch
@@ -82,10 +84,10 @@ class TetheredAerostatVectorEnv(VectorEnv):
         pending = self._pending.copy()
         b.step(~pending)
         self._steps[~pending] += 1
-        rewards = b.TERMS.sum(axis=1)
-        code = b.CODE
-        terminated = (code != spaces.RUNNING) & (code != spaces.FIELD_END) & ~pending
-        truncated = ((code == spaces.FIELD_END) | (self._steps >= self.max_episode_steps)) \
+        rewards = b.terms.sum(axis=1)
+        code = b.code
+        terminated = (code != RUNNING) & (code != FIELD_END) & ~pending
+        truncated = ((code == FIELD_END) | (self._steps >= self.max_episode_steps)) \
             & ~pending & ~terminated
         info = self._step_info(clipped, pending, terminated, truncated)
         done = terminated | truncated
@@ -95,22 +97,22 @@ class TetheredAerostatVectorEnv(VectorEnv):
             info.update(_stack_infos(resets, self.num_envs, prefix="reset_"))
         for i in np.flatnonzero(~pending):
             self._noise(i)
+        if self.task.reward_fn is not None:
+            self._custom_rewards(rewards, pending, info)
         if self.autoreset_mode == AutoresetMode.NEXT_STEP:
             self._pending = done.copy()
         elif done.any():
-            info["final_obs"] = np.array([b.OBS[i].copy() if d else None
+            info["final_obs"] = np.array([b.obs[i].copy() if d else None
                                           for i, d in enumerate(done)], dtype=object)
             info["_final_obs"] = done.copy()
             resets = [(i, self._reset(i, {})) for i in np.flatnonzero(done)]
             info.update(_stack_infos(resets, self.num_envs, prefix="reset_"))
-        return b.OBS.copy(), rewards, terminated, truncated, info
+        return b.obs.copy(), rewards, terminated, truncated, info
 
     def render(self):
         """An rgb_array frame of environment 0 (None without a render_mode)."""
         if self.render_mode is None:
             return None
-        from .render import Renderer
-
         if self._renderer is None:
             self._renderer = Renderer(self.batch.params, "rgb_array",
                                       fps=round(1.0 / self.task.control_step))
@@ -136,21 +138,31 @@ class TetheredAerostatVectorEnv(VectorEnv):
         b = self.batch
         stepped = ~pending
         info = {}
-        for j, k in enumerate(spaces.REWARD_TERMS):
-            info["reward_" + k] = np.where(stepped, b.TERMS[:, j], 0.0)
+        for j, k in enumerate(reward.REWARD_TERMS):
+            info["reward_" + k] = np.where(stepped, b.terms[:, j], 0.0)
             info["_reward_" + k] = stepped
+        info["peak_tension"], info["_peak_tension"] = np.where(stepped, b.peak, 0.0), stepped
         info["action_clipped"], info["_action_clipped"] = clipped & stepped, stepped
         ended = terminated | truncated
         if ended.any():
             key = {True: "termination", False: "truncation"}
             for i in np.flatnonzero(ended):
                 name = key[bool(terminated[i])]
-                code = int(b.CODE[i])
-                reason = spaces.OUTCOMES.get(code, "time_limit")
+                code = int(b.code[i])
+                reason = OUTCOMES.get(code, "time_limit")
                 _put(info, name, i, reason, self.num_envs)
-                if code == spaces.NONFINITE:
+                if code == NONFINITE:
                     _put(info, "failure", i, reason, self.num_envs)
         return info
+
+    def _custom_rewards(self, rewards, pending, info) -> None:
+        """Replace the stepped slots' rewards by the user's reward_fn (env i's own info)."""
+        b = self.batch
+        for i in np.flatnonzero(~pending):
+            info_i = {k: v[i] for k, v in info.items()
+                      if not k.startswith("_") and info["_" + k][i]}
+            rewards[i] = reward.custom_reward(self.task.reward_fn, b.obs[i].copy(),
+                                              b.action[i], info_i)
 
     def __getstate__(self):
         d = dict(self.__dict__)
@@ -202,65 +214,3 @@ def _stack_infos(pairs, n, prefix=""):
 def make_vec(num_envs: int = 1, **kwargs) -> TetheredAerostatVectorEnv:
     """The vector entry point registered for ``TetheredAerostat-v0``."""
     return TetheredAerostatVectorEnv(num_envs=num_envs, **kwargs)
-
-
-# --- Stable-Baselines3 -----------------------------------------------------------------------
-
-
-def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
-    """A Stable-Baselines3 ``VecEnv`` over one compiled batch of ``num_envs`` environments."""
-    from stable_baselines3.common.vec_env import VecEnv
-
-    class SB3VecEnv(VecEnv):
-        """SB3 adapter: same-step autoreset, ``terminal_observation`` and
-        ``TimeLimit.truncated`` in the per-environment infos."""
-
-        def __init__(self):
-            self.venv = TetheredAerostatVectorEnv(num_envs, autoreset_mode="SameStep", **kwargs)
-            self.render_mode = None
-            super().__init__(num_envs, self.venv.single_observation_space,
-                             self.venv.single_action_space)
-            self._actions = None
-            if seed is not None:
-                self.seed(seed)
-
-        def reset(self):
-            seeds = self._seeds if any(s is not None for s in self._seeds) else None
-            obs, info = self.venv.reset(seed=seeds)
-            self._seeds = [None] * self.num_envs
-            self.reset_infos = [{} for _ in range(self.num_envs)]
-            return obs
-
-        def step_async(self, actions):
-            self._actions = actions
-
-        def step_wait(self):
-            obs, rew, term, trunc, info = self.venv.step(self._actions)
-            dones = term | trunc
-            infos = [{} for _ in range(self.num_envs)]
-            if dones.any():
-                for i in np.flatnonzero(dones):
-                    infos[i]["terminal_observation"] = info["final_obs"][i]
-                    infos[i]["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
-                    for key in ("termination", "failure", "truncation"):
-                        if key in info and info["_" + key][i]:
-                            infos[i][key] = info[key][i]
-            return obs, rew.astype(np.float32), dones, infos
-
-        def close(self):
-            self.venv.close()
-
-        def get_attr(self, attr_name, indices=None):
-            return [getattr(self.venv, attr_name, None) for _ in self._get_indices(indices)]
-
-        def set_attr(self, attr_name, value, indices=None):
-            setattr(self.venv, attr_name, value)
-
-        def env_method(self, method_name, *args, indices=None, **kw):
-            return [getattr(self.venv, method_name)(*args, **kw)
-                    for _ in self._get_indices(indices)]
-
-        def env_is_wrapped(self, wrapper_class, indices=None):
-            return [False for _ in self._get_indices(indices)]
-
-    return SB3VecEnv()

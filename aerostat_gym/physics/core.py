@@ -42,8 +42,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .layout import (
-    MAX_FINS,
+from .packing import (
     P_AF,
     P_ANCHOR,
     P_ASTALL,
@@ -91,35 +90,35 @@ from .layout import (
     P_W_TAU,
     P_W_VMAX,
 )
+from .state import (
+    S_LENGTH,
+    S_P,
+    S_PHI,
+    S_PSI,
+    S_Q,
+    S_R,
+    S_REEL,
+    S_THETA,
+    S_VX,
+    S_VY,
+    S_VZ,
+    aerostat_offset,
+    node_force_offset,
+    node_vel_offset,
+    points_offset,
+    scratch_offset,
+    tension_offset,
+)
 from .wind import W_DIRC, W_DIRS, W_GUST_ON, W_PROFILE, W_TURB_ON, W_UREF, air_velocity, mean_speed
 
 # fastmath without the no-NaN/no-Inf assumptions, so non-finite states are still detected.
 FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
-# Work-array layout: node positions, velocities and forces, 3 (n + 1) each (node 0 = confluence
-# point, node n = anchor); the n element tensions; the wind sample points (n element midpoints,
-# the hull point, the fin points), 3 each, followed by the air velocity at each of them; then the
-# tether's per-element scratch: (v_t, |v_n|^2) pairs, 2 n, and unit vectors e, 3 n.
+# Work-array layout: see aerostat_gym.physics.state.
 #
 # The loops index the work array through views (w[a:b]) with indices from range(): numba wraps
 # negative indices, and with an offset computed at run time (w[base + i]) every access carries
 # that select, which also keeps LLVM from vectorizing. Measured: 0.42 -> 0.29 us per call.
-
-
-def work_size(n: int) -> int:
-    return _scratch(n) + 5 * n
-
-
-@njit(cache=True, inline="always")
-def _scratch(n):
-    """Offset of the tether's per-element scratch (5 n floats) in the work array."""
-    return _pts(n) + 6 * (n + 1 + MAX_FINS)
-
-
-@njit(cache=True, inline="always")
-def _pts(n):
-    """Offset of the wind sample points in the work array (their winds follow them)."""
-    return 9 * (n + 1) + n
 
 
 # atan(r) = r P(r^2) on [0, 1], least-squares fit on Chebyshev nodes: max error 8.3e-12 rad.
@@ -176,6 +175,13 @@ def rotation_matrix(ph, th, ps):
     return out
 
 
+def euler_angles(R: np.ndarray) -> tuple[float, float, float]:
+    """Z-Y-X Euler angles (phi, theta, psi) of a body-to-inertial rotation matrix, the inverse
+    of :func:`rotation_matrix` for |theta| < pi/2."""
+    return (math.atan2(R[2, 1], R[2, 2]), -math.asin(max(-1.0, min(1.0, R[2, 0]))),
+            math.atan2(R[1, 0], R[0, 0]))
+
+
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _kinematics(x, p, R, w):
     """Fill the work array with node positions and velocities (node 0 = confluence point from
@@ -183,19 +189,19 @@ def _kinematics(x, p, R, w):
     midpoints, then the hull point (centre of buoyancy), then each fin's point."""
     n = int(p[P_NEL])
     nm = n - 1
-    o = 6 * nm
-    P, V, PT = 0, 3 * (n + 1), _pts(n)
+    o = aerostat_offset(n)
+    V, PT = node_vel_offset(n), points_offset(n)
     xl, yl, zl = p[P_LEASH], p[P_LEASH + 1], p[P_LEASH + 2]
-    pp, qq, rr = x[o + 9], x[o + 10], x[o + 11]
+    pp, qq, rr = x[o + S_P], x[o + S_Q], x[o + S_R]
     wx, wy, wz = qq * zl - rr * yl, rr * xl - pp * zl, pp * yl - qq * xl
     for k in range(3):
         # confluence point r_cm + R r_l, velocity v_cm + R (omega x r_l)
-        w[P + k] = x[o + k] + R[3 * k] * xl + R[3 * k + 1] * yl + R[3 * k + 2] * zl
-        w[V + k] = x[o + 3 + k] + R[3 * k] * wx + R[3 * k + 1] * wy + R[3 * k + 2] * wz
-        w[P + 3 * n + k] = p[P_ANCHOR + k]
+        w[k] = x[o + k] + R[3 * k] * xl + R[3 * k + 1] * yl + R[3 * k + 2] * zl
+        w[V + k] = x[o + S_VX + k] + R[3 * k] * wx + R[3 * k + 1] * wy + R[3 * k + 2] * wz
+        w[3 * n + k] = p[P_ANCHOR + k]
         w[V + 3 * n + k] = 0.0
     # views: indices from range() are known non-negative (no wraparound selects)
-    pos, vel, mid = w[:3 * (n + 1)], w[3 * (n + 1):6 * (n + 1)], w[PT:PT + 3 * n]
+    pos, vel, mid = w[:V], w[V:node_force_offset(n)], w[PT:PT + 3 * n]
     xp, xv = x[:3 * nm], x[3 * nm:6 * nm]
     for i in range(3 * nm):
         pos[3 + i] = xp[i]
@@ -252,22 +258,23 @@ def _tether(x, p, w):
     _element_geometry(x, p, w, n)
     _element_drag(x, p, w, n)
     _node_forces(x, p, w, n)
-    return w[9 * (n + 1) + n - 1]
+    return w[tension_offset(n) + n - 1]
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _element_geometry(x, p, w, n):
     """Per element: unit vector e (upper minus lower node), tension, and the midpoint velocity
     relative to the air split into its tangential part v_t = v.e and normal part v_n."""
-    o = 6 * (n - 1)
-    L = x[o + 12]
+    o = aerostat_offset(n)
+    L = x[o + S_LENGTH]
     l_u = L / n
     il_u = 1.0 / l_u
-    rate = x[o + 13] / L  # Ldot / L: the strain rate's unstretched-length term
+    rate = x[o + S_REEL] / L  # Ldot / L: the strain rate's unstretched-length term
     EA, cs = p[P_EA], p[P_DASHPOT]
     # views of the work array (indices from range() are then known non-negative: no
     # wraparound selects in the loop)
-    pos, vel, ten = w[:3 * (n + 1)], w[3 * (n + 1):6 * (n + 1)], w[9 * (n + 1):9 * (n + 1) + n]
+    V, T0 = node_vel_offset(n), tension_offset(n)
+    pos, vel, ten = w[:V], w[V:node_force_offset(n)], w[T0:T0 + n]
     wn, vv, ev = _element_views(p, w, n)
     for e in range(n):
         a = 3 * e
@@ -302,8 +309,8 @@ def _element_views(p, w, n):
     """Per-element slots of the work array: the wind at the element midpoints (overwritten by
     the normal relative velocity v_n), the (v_t, |v_n|^2) pairs (overwritten by the drag
     factors), the unit vectors e."""
-    WN = _pts(n) + 3 * (n + 1 + int(p[P_NFIN]))
-    S = _scratch(n)
+    WN = points_offset(n) + 3 * (n + 1 + int(p[P_NFIN]))
+    S = scratch_offset(n)
     return w[WN:WN + 3 * n], w[S:S + 2 * n], w[S + 2 * n:S + 5 * n]
 
 
@@ -312,8 +319,8 @@ def _element_drag(x, p, w, n):
     """Morison drag with loading functions, from the midpoint velocity v relative to the air:
     D = q |v|^2 [f_n(phi) (-v_n/|v_n|) + f_t(phi) (-sign(v.e) e)], phi in [0, pi/2] the angle
     between v and the element axis. Stores D = k_n v_n + k_t e as the two factors (k_n, k_t)."""
-    o = 6 * (n - 1)
-    l_u = x[o + 12] / n
+    o = aerostat_offset(n)
+    l_u = x[o + S_LENGTH] / n
     qd = 0.5 * p[P_RHO] * p[P_CDN] * p[P_DIAM] * l_u
     f0, f1, f2, f3, f4 = p[P_FN], p[P_FN + 1], p[P_FN + 2], p[P_FN + 3], p[P_FN + 4]
     t0, t1, t2, t3, t4, t5 = p[P_FT], p[P_FT + 1], p[P_FT + 2], p[P_FT + 3], p[P_FT + 4], p[P_FT + 5]
@@ -343,9 +350,10 @@ def _node_forces(x, p, w, n):
     """Node forces: node j gets T e + D/2 from the element above it (j-1, of which it is the
     lower node) and -T e + D/2 from the element below (j), plus gravity (full node mass inside,
     half an element at the confluence point)."""
-    o = 6 * (n - 1)
-    g = p[P_MU] * x[o + 12] / n * p[P_G]
-    frc, ten = w[6 * (n + 1):9 * (n + 1)], w[9 * (n + 1):9 * (n + 1) + n]
+    o = aerostat_offset(n)
+    g = p[P_MU] * x[o + S_LENGTH] / n * p[P_G]
+    F, T0 = node_force_offset(n), tension_offset(n)
+    frc, ten = w[F:T0], w[T0:T0 + n]
     vn, kk, ev = _element_views(p, w, n)
     ux = uy = uz = 0.0  # force on node j from element j-1 (none above node 0)
     for j in range(n + 1):
@@ -370,7 +378,7 @@ def _node_forces(x, p, w, n):
 def tether_forces(t, x, p, wp, wf, R, w):
     """Kinematics, winds, tensions and node forces; returns the winch-end element tension."""
     npts = _kinematics(x, p, R, w)
-    wind_batch(t, w, npts, _pts(int(p[P_NEL])), wp, wf)
+    wind_batch(t, w, npts, points_offset(int(p[P_NEL])), wp, wf)
     return _tether(x, p, w)
 
 
@@ -441,7 +449,7 @@ def rhs(t, x, u, p, wp, wf, dx, w):
 
     Parameters
     ----------
-    t : float, time [s]. x : state (layout in :mod:`aerostat_gym.physics.layout`).
+    t : float, time [s]. x : state (layout in :mod:`aerostat_gym.physics.state`).
     u : [reel-out speed set-point (m/s), brake flag]. p : packed parameters.
     wp, wf : wind parameter vector and turbulence field (:mod:`aerostat_gym.physics.wind`).
     dx : output array, same size as x. w : work array of ``work_size(n)`` floats; on return it
@@ -454,15 +462,15 @@ def rhs(t, x, u, p, wp, wf, dx, w):
     """
     n = int(p[P_NEL])
     nm = n - 1
-    o = 6 * nm
-    R = _rotation(x[o + 6], x[o + 7], x[o + 8])
+    o = aerostat_offset(n)
+    R = _rotation(x[o + S_PHI], x[o + S_THETA], x[o + S_PSI])
     npts = _kinematics(x, p, R, w)
-    wind_batch(t, w, npts, _pts(n), wp, wf)
+    wind_batch(t, w, npts, points_offset(n), wp, wf)
     loads = _aero_loads(x, p, w, R, o)
     Tw = _tether(x, p, w)
-    F = 6 * (n + 1)
+    F = node_force_offset(n)
     # moving nodes: position' = velocity, velocity' = force / node mass (views: no wraparound)
-    im_node = n / (p[P_MU] * x[o + 12])
+    im_node = n / (p[P_MU] * x[o + S_LENGTH])
     xv, dxp, dxv, frc = x[3 * nm:6 * nm], dx[:3 * nm], dx[3 * nm:6 * nm], w[F + 3:F + 3 * n]
     for i in range(3 * nm):
         dxp[i] = xv[i]
@@ -481,8 +489,8 @@ def _aero_loads(x, p, w, R, o):
     points are read from the work array)."""
     n = int(p[P_NEL])
     nf = int(p[P_NFIN])
-    vx, vy, vz = x[o + 3], x[o + 4], x[o + 5]
-    pp, qq, rr = x[o + 9], x[o + 10], x[o + 11]
+    vx, vy, vz = x[o + S_VX], x[o + S_VY], x[o + S_VZ]
+    pp, qq, rr = x[o + S_P], x[o + S_Q], x[o + S_R]
     # body components of the CM velocity
     ub = R[0] * vx + R[3] * vy + R[6] * vz
     vb = R[1] * vx + R[4] * vy + R[7] * vz
@@ -499,7 +507,7 @@ def _aero_loads(x, p, w, R, o):
     My = zb * B * zx - xb * B * zz
     Mz = xb * B * zy - yb * B * zx
     # hull: air-relative velocity at the centre of buoyancy (the hull's volume centroid)
-    WA = _pts(n) + 3 * (2 * n + 1 + nf)  # wind at the hull point, then at each fin
+    WA = points_offset(n) + 3 * (2 * n + 1 + nf)  # wind at the hull point, then at each fin
     hx, hy, hz = _air_body(ub, vb, wb, pp, qq, rr, xb, yb, zb, R, w[WA], w[WA + 1], w[WA + 2])
     hfx, hfy, hfz, hmy, hmz = _hull(hx, hy, hz, p)
     xn, yn, zn = p[P_NOSE], p[P_NOSE + 1], p[P_NOSE + 2]
@@ -533,8 +541,8 @@ def _aerostat(x, p, R, loads, flx, fly, flz, dx, o):
     R00, R01, R02, R10, R11, R12, R20, R21, R22, cph, sph, cth, sth = R
     Fx, Fy, Fz, Mx, My, Mz = loads
     icth = 1.0 / cth
-    vx, vy, vz = x[o + 3], x[o + 4], x[o + 5]
-    pp, qq, rr = x[o + 9], x[o + 10], x[o + 11]
+    vx, vy, vz = x[o + S_VX], x[o + S_VY], x[o + S_VZ]
+    pp, qq, rr = x[o + S_P], x[o + S_Q], x[o + S_R]
     # body components of the CM velocity
     ub = R00 * vx + R10 * vy + R20 * vz
     vb = R01 * vx + R11 * vy + R21 * vz
@@ -556,10 +564,10 @@ def _aerostat(x, p, R, loads, flx, fly, flz, dx, o):
     aby = (Fy + gy) / p[P_ME + 1]
     abz = (Fz + gz) / p[P_ME + 2]
     for k in range(3):
-        dx[o + k] = x[o + 3 + k]
-    dx[o + 3] = R00 * abx + R01 * aby + R02 * abz
-    dx[o + 4] = R10 * abx + R11 * aby + R12 * abz
-    dx[o + 5] = R20 * abx + R21 * aby + R22 * abz
+        dx[o + k] = x[o + S_VX + k]
+    dx[o + S_VX] = R00 * abx + R01 * aby + R02 * abz
+    dx[o + S_VY] = R10 * abx + R11 * aby + R12 * abz
+    dx[o + S_VZ] = R20 * abx + R21 * aby + R22 * abz
     # rotation: I domega = M - omega x (I omega) - V x (M_a V)
     I = P_INERTIA
     Lx = p[I] * pp + p[I + 1] * qq + p[I + 2] * rr
@@ -569,14 +577,14 @@ def _aerostat(x, p, R, loads, flx, fly, flz, dx, o):
     My -= rr * Lx - pp * Lz + (wb * Pax - ub * Paz)
     Mz -= pp * Ly - qq * Lx + (ub * Pay - vb * Pax)
     J = P_IINV
-    dx[o + 9] = p[J] * Mx + p[J + 1] * My + p[J + 2] * Mz
-    dx[o + 10] = p[J + 3] * Mx + p[J + 4] * My + p[J + 5] * Mz
-    dx[o + 11] = p[J + 6] * Mx + p[J + 7] * My + p[J + 8] * Mz
+    dx[o + S_P] = p[J] * Mx + p[J + 1] * My + p[J + 2] * Mz
+    dx[o + S_Q] = p[J + 3] * Mx + p[J + 4] * My + p[J + 5] * Mz
+    dx[o + S_R] = p[J + 6] * Mx + p[J + 7] * My + p[J + 8] * Mz
     # Z-Y-X Euler kinematics
     tth = sth * icth
-    dx[o + 6] = pp + (qq * sph + rr * cph) * tth
-    dx[o + 7] = qq * cph - rr * sph
-    dx[o + 8] = (qq * sph + rr * cph) * icth
+    dx[o + S_PHI] = pp + (qq * sph + rr * cph) * tth
+    dx[o + S_THETA] = qq * cph - rr * sph
+    dx[o + S_PSI] = (qq * sph + rr * cph) * icth
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -596,7 +604,7 @@ def _winch(x, u, p, Tw, dx, o):
     force on the reflected drivetrain m_eq v_w' = T + F_m - F_c tanh(v_w/v_f) - c_v v_w with
     |F_m| <= F_max, so the force limit (not the formula) decides when the loop loses authority.
     The brake (u[1] != 0) holds the drum: both derivatives zero (the Python-side controller,
-    :mod:`aerostat_gym.winch`, brings v_w to zero before it engages the brake).
+    :mod:`aerostat_gym.sim.winch`, brings v_w to zero before it engages the brake).
 
     v_s is the set-point clipped to +-v_max and then capped near the length limits by the
     stopping profile v_cap(d) = min(d / (4 tau), sqrt(a_max d)), d the distance to the limit.
@@ -604,10 +612,10 @@ def _winch(x, u, p, Tw, dx, o):
     part makes the closed loop critically damped at the limit (tau d'' + d' + d / (4 tau) = 0),
     so the drum stops at the limit without overshoot when the motor has authority.
     """
-    L, v = x[o + 12], x[o + 13]
+    L, v = x[o + S_LENGTH], x[o + S_REEL]
     if u[1] != 0.0:
-        dx[o + 12] = 0.0
-        dx[o + 13] = 0.0
+        dx[o + S_LENGTH] = 0.0
+        dx[o + S_REEL] = 0.0
         return
     vmax, a_max, tau = p[P_W_VMAX], p[P_W_AMAX], p[P_W_TAU]
     vs = min(max(u[0], -vmax), vmax)
@@ -617,16 +625,23 @@ def _winch(x, u, p, Tw, dx, o):
     vs = max(vs, -min(d_lo / (4.0 * tau), math.sqrt(a_max * d_lo)))
     a_des = min(max((vs - v) / tau, -a_max), a_max)
     m_eq = p[P_W_MEQ]
-    fr = p[P_W_FC] * math.tanh(v / p[P_W_FRICTION_V]) + p[P_W_CV] * v
+    fr = winch_friction(v, p)
     Fm = min(max(m_eq * a_des - Tw + fr, -p[P_W_FMAX]), p[P_W_FMAX])
-    dx[o + 12] = v
-    dx[o + 13] = (Tw + Fm - fr) / m_eq
+    dx[o + S_LENGTH] = v
+    dx[o + S_REEL] = (Tw + Fm - fr) / m_eq
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def winch_friction(v, p):
+    """Drivetrain friction at the line [N] for reel speed v: Coulomb, smoothed as
+    F_c tanh(v / v_f) so the speed loop stays differentiable through v = 0, plus viscous c_v v."""
+    return p[P_W_FC] * math.tanh(v / p[P_W_FRICTION_V]) + p[P_W_CV] * v
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)
 def evaluate_tether(t, x, p, wp, wf, w):
     """Fill the work array (node kinematics, forces, tensions) for state x; returns the
     winch-end element tension. Used for outputs; :func:`rhs` does the same internally."""
-    o = 6 * (int(p[P_NEL]) - 1)
-    R = _rotation(x[o + 6], x[o + 7], x[o + 8])
+    o = aerostat_offset(int(p[P_NEL]))
+    R = _rotation(x[o + S_PHI], x[o + S_THETA], x[o + S_PSI])
     return tether_forces(t, x, p, wp, wf, R, w)

@@ -22,7 +22,23 @@ import numpy as np
 from numba import njit
 
 from .core import FASTMATH, _rotation, rhs
-from .layout import P_DASHPOT, P_EA, P_FIXED, P_INERTIA, P_LEASH, P_ME, P_MU, P_NEL
+from .packing import P_DASHPOT, P_EA, P_FIXED, P_INERTIA, P_LEASH, P_ME, P_MU, P_NEL
+from .state import (
+    S_LENGTH,
+    S_P,
+    S_PHI,
+    S_PSI,
+    S_Q,
+    S_R,
+    S_REEL,
+    S_THETA,
+    S_VX,
+    S_VY,
+    S_VZ,
+    aerostat_offset,
+    node_vel_offset,
+    tension_offset,
+)
 
 OK, NONFINITE = 0, 1
 RK4_STABILITY = 2.0 * math.sqrt(2.0)  # RK4 stability limit on the imaginary axis, |lambda| h
@@ -49,7 +65,7 @@ def rk4_step(EA: float, mu: float, l_u: float, safety: float, n: int) -> float:
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _tension_stats(w, n, stats):
-    T0 = 9 * (n + 1)
+    T0 = tension_offset(n)
     tmax = 0.0
     for e in range(n):
         tmax = max(tmax, w[T0 + e])
@@ -143,13 +159,13 @@ def _element_matrices(w, n, l_u, h, p, G, K):
     Slack elements keep their axial stiffness in the matrix (not in the force), which keeps the
     step stable when an element goes in and out of tension.
     """
-    P, T0 = 0, 9 * (n + 1)
+    T0 = tension_offset(n)
     EA, cs = p[P_EA], p[P_DASHPOT]
     for e in range(n):
         a, b = 3 * e, 3 * (e + 1)
-        d0 = w[P + a] - w[P + b]
-        d1 = w[P + a + 1] - w[P + b + 1]
-        d2 = w[P + a + 2] - w[P + b + 2]
+        d0 = w[a] - w[b]
+        d1 = w[a + 1] - w[b + 1]
+        d2 = w[a + 2] - w[b + 2]
         ln = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         ev = (d0 / ln, d1 / ln, d2 / ln)
         T = w[T0 + e]
@@ -177,7 +193,7 @@ def si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats):
     m = x.size
     n = int(p[P_NEL])
     nm = n - 1
-    o = 6 * nm
+    o = aerostat_offset(n)
     a = np.empty(m)
     G = np.empty((n, 3, 3))
     K = np.empty((n, 3, 3))
@@ -192,11 +208,11 @@ def si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats):
         ts = t + s * h
         rhs(ts, x, u, p, wp, wf, a, w)
         _tension_stats(w, n, stats)
-        L = x[o + 12]
+        L = x[o + S_LENGTH]
         l_u = L / n
         mn = p[P_MU] * l_u
         _element_matrices(w, n, l_u, h, p, G, K)
-        R = _rotation(x[o + 6], x[o + 7], x[o + 8])
+        R = _rotation(x[o + S_PHI], x[o + S_THETA], x[o + S_PSI])
         # J = [I, -R S(r_l)]: d(confluence point) = d r_cm + R (dTheta x r_l)
         xl, yl, zl = p[P_LEASH], p[P_LEASH + 1], p[P_LEASH + 2]
         for i in range(3):
@@ -207,7 +223,7 @@ def si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats):
             J[i, 4] = -(-Ri0 * zl + Ri2 * xl)
             J[i, 5] = -(Ri0 * yl - Ri1 * xl)
         # right-hand sides: h M a - h^2 K v (element relative velocities from the work array)
-        V = 3 * (n + 1)
+        V = node_vel_offset(n)
         for j in range(nm):
             for k in range(3):
                 Y[j, k] = h * mn * a[3 * nm + 3 * j + k]
@@ -269,17 +285,17 @@ def si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats):
                 x[3 * nm + 3 * j + k] += Y[j, k]
                 x[3 * j + k] += h * x[3 * nm + 3 * j + k]
         for k in range(3):
-            x[o + 3 + k] += y0[k]
-            x[o + k] += h * x[o + 3 + k]
-            x[o + 9 + k] += y0[3 + k]
-        ph, th = x[o + 6], x[o + 7]
-        pp, qq, rr = x[o + 9], x[o + 10], x[o + 11]
+            x[o + S_VX + k] += y0[k]
+            x[o + k] += h * x[o + S_VX + k]
+            x[o + S_P + k] += y0[3 + k]
+        ph, th = x[o + S_PHI], x[o + S_THETA]
+        pp, qq, rr = x[o + S_P], x[o + S_Q], x[o + S_R]
         cph, sph, cth = math.cos(ph), math.sin(ph), math.cos(th)
-        x[o + 6] += h * (pp + (qq * sph + rr * cph) * math.sin(th) / cth)
-        x[o + 7] += h * (qq * cph - rr * sph)
-        x[o + 8] += h * (qq * sph + rr * cph) / cth
-        x[o + 13] += h * a[o + 13]
-        x[o + 12] += h * x[o + 13]
+        x[o + S_PHI] += h * (pp + (qq * sph + rr * cph) * math.sin(th) / cth)
+        x[o + S_THETA] += h * (qq * cph - rr * sph)
+        x[o + S_PSI] += h * (qq * sph + rr * cph) / cth
+        x[o + S_REEL] += h * a[o + S_REEL]
+        x[o + S_LENGTH] += h * x[o + S_REEL]
     if not _finite(x):
         return NONFINITE
     return OK
@@ -346,10 +362,59 @@ def _aerostat_rhs(x, a, p, R, h, o, y0):
     for i in range(3):
         s = 0.0
         for k in range(3):
-            ab = R[k] * a[o + 3] + R[3 + k] * a[o + 4] + R[6 + k] * a[o + 5]  # body accel comp k
+            ab = R[k] * a[o + S_VX] + R[3 + k] * a[o + S_VY] + R[6 + k] * a[o + S_VZ]  # body accel comp k
             s += R[3 * i + k] * p[P_ME + k] * ab
         y0[i] = h * s
         s = 0.0
         for k in range(3):
-            s += p[P_INERTIA + 3 * i + k] * a[o + 9 + k]
+            s += p[P_INERTIA + 3 * i + k] * a[o + S_P + k]
         y0[3 + i] = h * s
+
+
+# --- the interval advance shared by every front end -------------------------------------------------
+
+#: Integration scheme vector, the compiled interval advance's settings (see :func:`scheme`).
+SCHEME_SEMI_IMPLICIT = 0  # 1: semi-implicit step, 0: RK4
+SCHEME_STEP = 1  # fixed step [s]; 0 picks the scheme's own (RK4 bound at the current L, or si_dt)
+SCHEME_RK4_SAFETY = 2  # fraction of the RK4 axial stability bound
+SCHEME_SI_DT = 3  # semi-implicit step [s]
+SCHEME_SIZE = 4
+INTEGRATORS = ("rk4", "semi-implicit")
+
+
+def scheme(integrator: str, rk4_safety: float, si_dt: float, step: float | None = None) -> np.ndarray:
+    """The scheme vector of :func:`advance_interval` for an integrator name ("rk4" or
+    "semi-implicit"), its settings and an optional fixed step [s]."""
+    out = np.zeros(SCHEME_SIZE)
+    out[SCHEME_SEMI_IMPLICIT] = 1.0 if integrator == "semi-implicit" else 0.0
+    out[SCHEME_STEP] = step or 0.0
+    out[SCHEME_RK4_SAFETY] = rk4_safety
+    out[SCHEME_SI_DT] = si_dt
+    return out
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def advance_interval(x, t, interval, u, p, wp, wf, w, sch, stats):
+    """Advance x in place over ``interval`` seconds from time t with input u held; returns the
+    status (``OK`` or ``NONFINITE``) and fills ``stats`` (module docstring).
+
+    The interval is split into the fewest equal steps no longer than the scheme's step: a
+    fixed step if one is set, else the semi-implicit step or the RK4 axial stability bound at
+    the current paid-out length (it tightens as the tether is reeled in: shorter elements).
+    The simulator (:meth:`aerostat_gym.sim.Model.advance`) and the environment's compiled
+    control step both call this function, so they take the same steps bit for bit.
+    """
+    n = int(p[P_NEL])
+    semi = sch[SCHEME_SEMI_IMPLICIT] != 0.0
+    if sch[SCHEME_STEP] > 0.0:
+        h_max = sch[SCHEME_STEP]
+    elif semi:
+        h_max = sch[SCHEME_SI_DT]
+    else:
+        L = x[aerostat_offset(n) + S_LENGTH]
+        h_max = rk4_step(p[P_EA], p[P_MU], L / n, sch[SCHEME_RK4_SAFETY], n)
+    nsteps = max(1, int(math.ceil(interval / h_max - 1e-9)))
+    h = interval / nsteps
+    if semi:
+        return si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats)
+    return rk4_advance(x, t, h, nsteps, u, p, wp, wf, w, stats)

@@ -8,11 +8,12 @@ import math
 from numba import njit
 
 from .core import FASTMATH
-from .layout import P_G, P_MU, P_NEL
+from .packing import P_G, P_MU, P_NEL
+from .state import S_LENGTH, aerostat_offset, node_force_offset, tension_offset
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)
-def winch_end_tension(x, p, w):
+def winch_tension(x, p, w):
     """Tether tension at the winch end [N], from a work array filled by ``evaluate_tether``.
 
     A lumped element carries the continuous tether's tension at its midpoint; the winch end
@@ -25,8 +26,8 @@ def winch_end_tension(x, p, w):
     dy = w[a + 1] - w[a + 4]
     dz = w[a + 2] - w[a + 5]
     inv = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
-    T = w[9 * (n + 1) + n - 1]
-    half = 0.5 * p[P_MU] * x[6 * (n - 1) + 12] / n * p[P_G]
+    T = w[tension_offset(n) + n - 1]
+    half = 0.5 * p[P_MU] * x[aerostat_offset(n) + S_LENGTH] / n * p[P_G]
     fx, fy, fz = T * dx * inv, T * dy * inv, T * dz * inv - half
     return math.sqrt(fx * fx + fy * fy + fz * fz)
 
@@ -35,5 +36,5 @@ def winch_end_tension(x, p, w):
 def confluence_tension(p, w):
     """Tether tension at the aerostat end [N]: magnitude of the total tether force at the
     confluence point (element 0 plus the half element lumped there)."""
-    F = 6 * (int(p[P_NEL]) + 1)
+    F = node_force_offset(int(p[P_NEL]))
     return math.sqrt(w[F] ** 2 + w[F + 1] ** 2 + w[F + 2] ** 2)

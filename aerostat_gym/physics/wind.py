@@ -66,7 +66,7 @@ W_TAYLOR_IDX = 24
 W_SIZE = 32
 
 PROFILES = {"uniform": 0, "power": 1, "log": 2}
-MIN_ADVECTION_SPEED = 0.5  # floor of U_a [m/s]: Taylor's hypothesis fails in calm air anyway
+MIN_ADVECTION_SPEED = 1.0  # floor of U_a [m/s]: Taylor's hypothesis fails in calm air anyway
 
 
 def pack_wind(profile: str = "uniform", speed: float = 0.0, direction_deg: float = 0.0,
@@ -74,7 +74,7 @@ def pack_wind(profile: str = "uniform", speed: float = 0.0, direction_deg: float
               roughness_length: float = 0.05) -> np.ndarray:
     """Wind-parameter vector for a steady mean wind (no gust, no turbulence).
 
-    The advection speed ``W_TAYLOR_U`` is set to max(speed, 0.5 m/s); :func:`set_advection`
+    The advection speed ``W_TAYLOR_U`` is set to max(speed, MIN_ADVECTION_SPEED); :func:`set_advection`
     or :func:`aerostat_gym.wind.build_wind` replace it with the speed at the aerostat height.
     """
     if profile not in PROFILES:
@@ -94,10 +94,12 @@ def pack_wind(profile: str = "uniform", speed: float = 0.0, direction_deg: float
     return wp
 
 
-def wind_from_params(wind) -> np.ndarray:
-    """Wind-parameter vector from a :class:`aerostat_gym.params.WindParams`."""
-    return pack_wind(wind.profile, wind.speed, wind.direction_deg, wind.reference_height,
-                     wind.shear_exponent, wind.roughness_length)
+def mean_wind(wind, speed: float | None = None) -> np.ndarray:
+    """Wind-parameter vector of the mean profile configured in a
+    :class:`aerostat_gym.params.WindParams`, at reference speed ``speed`` [m/s] (default: the
+    configured ``wind.speed``). The one place a configuration becomes a packed mean wind."""
+    return pack_wind(wind.profile, wind.speed if speed is None else speed, wind.direction_deg,
+                     wind.reference_height, wind.shear_exponent, wind.roughness_length)
 
 
 def set_advection(wp: np.ndarray, height: float, floor: float = MIN_ADVECTION_SPEED) -> float:

@@ -32,6 +32,7 @@ import math
 import numbers
 from dataclasses import dataclass, field, fields
 
+from ..physics.wind import MIN_ADVECTION_SPEED
 from .spectra import CONVENTIONS, KT, MODELS, W20_KT, integral_scale, mil_low_altitude, to_8785c
 
 METHODS = ("spectral", "filter")
@@ -83,7 +84,7 @@ class TurbulenceConfig:
                                 "(longest tether, 400 m)", 400.0)
     upwind_extent: float = _f("m", "ESTIMATE", "farthest upwind point the field serves", 50.0)
     min_advection_speed: float = _f("m/s", "ESTIMATE", "floor of U_a (Taylor fails below 1-2 m/s)",
-                                    1.0)
+                                    MIN_ADVECTION_SPEED)
 
     def __post_init__(self) -> None:
         _check_choice("model", self.model, MODELS)

@@ -11,10 +11,15 @@ import time
 import numpy as np
 from numba import njit
 
+from ..params import Params, load_params
 from ..physics.wind import NO_FIELD, W_TURB_ON, air_velocity, air_velocity_batch
-from .field import build_wind, mean_only
+from ..wind.field import build_wind, mean_only
 
-CALLS_PER_RHS = 14  # 10 tether elements + hull + 3 fins in the baseline model
+
+def calls_per_rhs(params: Params) -> int:
+    """Wind samples per right-hand-side call: one per tether element midpoint, the hull point
+    and one per fin (the points of :func:`aerostat_gym.physics.core.wind_batch`)."""
+    return params.tether.n_elements + 1 + len(params.fins.panels)
 
 
 def typical_points(n_tether: int = 10) -> np.ndarray:
@@ -68,7 +73,8 @@ def _ns_per_call(loop, points, t_end, n_steps, wp, wf, repeats: int) -> float:
 
 
 def bench_wind(duration: float = 600.0, preset: str = "moderate", speed: float = 8.0,
-               repeats: int = 7, n_steps: int = 50_000, seed: int = 0) -> dict:
+               repeats: int = 7, n_steps: int = 50_000, seed: int = 0,
+               params: Params | None = None) -> dict:
     """Field generation time and per-call cost of ``air_velocity`` with and without the field.
 
     Returns
@@ -79,8 +85,10 @@ def bench_wind(duration: float = 600.0, preset: str = "moderate", speed: float =
         ``ns_per_call_gust``, ``ns_per_call_field``, ``ns_per_call_field_gust`` (best of
         ``repeats`` loops of ``n_steps`` x 14 calls at :func:`typical_points`), the same through
         :func:`air_velocity_batch` (``ns_per_point_batch_*``) and ``extra_ns_per_rhs``
-        (14 x (field - mean only), per-point calls).
+        (:func:`calls_per_rhs` x (field - mean only), per-point calls; ``params`` default: the
+        baseline).
     """
+    calls = calls_per_rhs(params or load_params())
     mean = {"speed": speed}
     times = []
     for r in range(repeats):
@@ -99,8 +107,8 @@ def bench_wind(duration: float = 600.0, preset: str = "moderate", speed: float =
     return {"field_generation_s": float(np.median(times)), "field_shape": list(wf.shape),
             "field_mbytes": wf.nbytes / 2**20, **{f"ns_per_call_{k}": v for k, v in cost.items()},
             **{f"ns_per_point_batch_{k}": v for k, v in batch.items()},
-            "calls_per_rhs": CALLS_PER_RHS,
-            "extra_ns_per_rhs": CALLS_PER_RHS * (cost["field"] - cost["mean_only"])}
+            "calls_per_rhs": calls,
+            "extra_ns_per_rhs": calls * (cost["field"] - cost["mean_only"])}
 
 
 def _turb_off(wp: np.ndarray) -> np.ndarray:

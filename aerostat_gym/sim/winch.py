@@ -5,7 +5,7 @@ drivetrain reflected to the line, the motor force limit, the length-limit stoppi
 the brake that freezes the drum) live in the compiled right-hand side
 (:func:`aerostat_gym.physics.core._winch`), whose input is ``u = [v_set, brake]``. This module
 holds what a winch's supervisory controller does between control steps, so that
-:func:`aerostat_gym.simulation.simulate` and the Gymnasium environment share one copy:
+:func:`aerostat_gym.sim.simulate` and the Gymnasium environment share one copy:
 
 - set-point validation: a NaN or infinite set-point is an error (:class:`WinchInputError`,
   naming the value); a set-point beyond +-max_speed is clipped and counted;
@@ -26,20 +26,22 @@ Typical use, once per control step of length ``dt_c``::
     load = winch.load_cell(model.end_tensions(x)[1])
     events = winch.detect_events(t + dt_c, load, stats[0])
 
-The module also provides the reel-out/reel-in manoeuvre (:func:`reel_manoeuvre`) and the
-winch column of the input matrix B (:func:`winch_input_column`).
+The reel-out/reel-in manoeuvre is :mod:`aerostat_gym.analysis.manoeuvre`; the winch's column
+of the input matrix B is :func:`aerostat_gym.analysis.linear.input_jacobian`.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from .params import Params, load_params
-from .physics.layout import StateLayout
+from ..params import Params, load_params
+from ..physics.core import winch_friction
+from ..physics.state import StateLayout, tension_offset
+from .events import tether_broken
 
 
 class WinchInputError(ValueError):
@@ -176,9 +178,9 @@ class WinchController:
 
     # --- measurements and bookkeeping ----------------------------------------------------------
 
-    def load_cell(self, bottom_tension: float) -> float:
+    def load_cell(self, winch_tension: float) -> float:
         """Load-cell reading [N]: the tether tension at the winch end (noise-free)."""
-        return float(bottom_tension)
+        return float(winch_tension)
 
     @property
     def total_mass(self) -> float:
@@ -199,7 +201,7 @@ class WinchController:
         """Events at the end of a control step (onsets only for slack and over-tension).
 
         load_cell : the winch-end tension at time t [N]. peak_tension : the largest element
-        tension over the step [N] (``stats[0]`` of :meth:`aerostat_gym.simulation.Model.advance`).
+        tension over the step [N] (``stats[0]`` of :meth:`aerostat_gym.sim.Model.advance`).
         Returns a list of ``{"time", "event", "message", "value", "threshold"}`` dicts:
         ``winch_slack`` (load cell falls below slack_tension), ``over_tension`` (peak rises above
         safe_working_load), ``break`` (peak above the tether strength; every step it holds).
@@ -217,7 +219,7 @@ class WinchController:
                               f"element tension {peak_tension:.0f} N exceeded the safe working load "
                               f"{th.safe_working_load:.0f} N"))
         self._over = over
-        if peak_tension > th.strength:
+        if tether_broken(peak_tension, th.strength):
             out.append(_event(t, "break", peak_tension, th.strength,
                               f"element tension {peak_tension:.0f} N exceeded the tether strength "
                               f"{th.strength:.0f} N"))
@@ -234,120 +236,11 @@ def _event(t: float, name: str, value: float, threshold: float, message: str) ->
 
 def motor_force(model, x: np.ndarray, u: np.ndarray, t: float = 0.0) -> float:
     """Motor force at the line [N] implied by the compiled core's drum acceleration:
-    F_m = m_eq v_w' - T_w + F_c tanh(v_w / v_f) + c_v v_w (NaN while braked)."""
+    F_m = m_eq v_w' - T_w + F_friction(v_w) (NaN while braked)."""
     if u[1] != 0.0:
         return math.nan
-    from .physics.layout import P_W_FRICTION_V
-
-    w, lay = model.params.winch, model.layout
+    lay = model.layout
     dx = model.rhs(x, u, t)
-    T0 = 9 * (model.n + 1)
-    Tw = model.work[T0 + model.n - 1]
+    Tw = model.work[tension_offset(model.n) + model.n - 1]
     v = x[lay.winch_speed]
-    fr = w.coulomb_friction * math.tanh(v / model.p[P_W_FRICTION_V]) + w.viscous_friction * v
-    return w.equivalent_mass * dx[lay.winch_speed] - Tw + fr
-
-
-# --- linearization: the winch column of B --------------------------------------------------------
-
-
-def winch_input_column(model, x: np.ndarray, eps: float = 1e-3, t: float = 0.0) -> np.ndarray:
-    """dF/dv_set at (x, u = [0, 0]) by central differences, brake released.
-
-    With the brake released and the set-point inside the limits the speed loop gives
-    v_w' = (v_set - v_w)/tau, so the column is 1/tau in the v_w row and zero elsewhere (the
-    coupling to the aerostat enters through A's L and v_w columns). ``eps`` must keep
-    eps/tau below max_acceleration so that the acceleration clip stays inactive.
-    """
-    up = model.rhs(x, np.array([eps, 0.0]), t)
-    um = model.rhs(x, np.array([-eps, 0.0]), t)
-    return (up - um) / (2.0 * eps)
-
-
-# --- reel-out / reel-in manoeuvre ----------------------------------------------------------------
-
-
-@dataclass
-class Manoeuvre:
-    """A reel-out/reel-in run: the trajectory, the trim it started from and its schedule."""
-
-    trajectory: object
-    equilibrium: object
-    target_length: np.ndarray = field(repr=False)
-    reel_in_time: float = 0.0
-
-
-def length_hold_law(target, speed: float, gain: float, length_index: int):
-    """u(t, x): set-point clip(gain (L_target(t) - L), +-speed), brake released; the winch's
-    brake rule engages the brake once |set-point| < brake_speed (near the target).
-    ``length_index`` is :attr:`StateLayout.winch_length`."""
-
-    def u(t, x):
-        L = x[length_index]
-        return [min(max(gain * (target(t) - L), -speed), speed), 0.0]
-
-    return u
-
-
-def reel_manoeuvre(params: Params | None = None, wind_speed: float = 10.0, distance: float = 50.0,
-                   speed: float | None = None, hold: float = 30.0, settle: float = 300.0,
-                   integrator: str = "rk4", dt: float | None = None, output_dt: float = 0.1,
-                   gain: float = 1.0) -> Manoeuvre:
-    """Reel out ``distance`` metres from the trim and back, in a steady wind.
-
-    From the trim at the configured tether length and ``wind_speed``, the length target is
-    L0 + distance until ``reel_in_time`` = distance / speed + hold, then L0; the set-point is
-    clip(gain (target - L), +-speed) (default speed: the winch's speed limit) and the brake
-    engages near each target. The run lasts reel_in_time + distance / speed + settle seconds.
-    """
-    from .analysis.trim import find_equilibrium
-    from .simulation import simulate
-
-    params = params or load_params()
-    speed = params.winch.max_speed if speed is None else float(speed)
-    if not (math.isfinite(speed) and speed > 0):
-        raise ValueError(f"speed must be finite and > 0, got {speed!r}")
-    eq = find_equilibrium(params, wind_speed)
-    iL = StateLayout(params.tether.n_elements).winch_length
-    L0 = float(eq.x[iL])
-    t_in = distance / speed + hold
-
-    def target(t):
-        return L0 + distance if t < t_in else L0
-
-    duration = t_in + distance / speed + settle
-    tr = simulate(params, eq.x, duration, wind=wind_speed, integrator=integrator, dt=dt,
-                  output_dt=output_dt, u=length_hold_law(target, speed, gain, iL))
-    targets = np.array([target(t) for t in tr.time])
-    return Manoeuvre(trajectory=tr, equilibrium=eq, target_length=targets, reel_in_time=t_in)
-
-
-def plot_manoeuvre(result: Manoeuvre, path) -> None:
-    """Length, reel speed, winch tension and aerostat altitude against time, into ``path``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    tr = result.trajectory
-    fig, ax = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
-    ax[0].plot(tr.time, tr.length, label="L")
-    ax[0].plot(tr.time, result.target_length, "--", label="target")
-    ax[0].set_ylabel("length paid out [m]")
-    ax[0].legend(loc="best")
-    ax[1].plot(tr.time, tr.reel_speed, label="v_w")
-    ax[1].step(tr.time[:-1], tr.v_set, where="post", lw=0.8, label="set-point")
-    ax[1].set_ylabel("reel-out speed [m/s]")
-    ax[1].legend(loc="best")
-    ax[2].plot(tr.time, tr.load_cell, label="winch (load cell)")
-    ax[2].plot(tr.time, tr.top_tension, lw=0.8, label="aerostat end")
-    ax[2].set_ylabel("tension [N]")
-    ax[2].legend(loc="best")
-    ax[3].plot(tr.time, tr.cm_pos[:, 2])
-    ax[3].set_ylabel("aerostat altitude [m]")
-    ax[3].set_xlabel("time [s]")
-    U = result.equilibrium.wind_speed
-    fig.suptitle(f"Reel-out / reel-in at U = {U:g} m/s ({tr.status})")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    return model.params.winch.equivalent_mass * dx[lay.winch_speed] - Tw + winch_friction(v, model.p)

@@ -13,10 +13,14 @@ import time
 import numpy as np
 from numba import njit
 
-from .analysis.trim import find_equilibrium
-from .params import Params, load_params
-from .physics.core import rhs
-from .simulation import BRAKED, Model, simulate
+from ..analysis.trim import find_equilibrium
+from ..params import Params, load_params
+from ..physics.core import rhs
+from ..sim import BRAKED, Model, simulate
+from .env import bench_env
+from .linear import bench_sweep
+from .moordyn import compare_with_moordyn
+from .wind import bench_wind
 
 
 @njit(cache=True)
@@ -108,17 +112,9 @@ def run_bench(quick: bool = False) -> dict:
 
 
 def _extra_benches():
-    """Benchmarks contributed by other modules (wind, peer comparison, env), when present."""
-    try:
-        from .bench_peer import compare_with_moordyn
-    except ImportError:
-        pass
-    else:
-        yield "moordyn_comparison", compare_with_moordyn
-    from .analysis.bench_linear import bench_sweep
-    from .envs.bench import bench_env
-    from .wind.bench import bench_wind
-
+    """Benchmarks of the other layers (peer comparison when MoorDyn is installed, wind, linear
+    sweep, environment)."""
+    yield "moordyn_comparison", compare_with_moordyn
     yield "wind", lambda quick: bench_wind()
     yield "linear_sweep", lambda quick: bench_sweep()
     yield "environment", bench_env

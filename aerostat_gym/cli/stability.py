@@ -16,13 +16,16 @@ and exits with status 2).
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 
 import numpy as np
 
-from ..params import load_params
+from ..analysis.figures import figure9_data, write_figure9
+from ..analysis.modes import FIGURE9_MODES, SETS, wind_sweep
+from ..analysis.reference import format_table2, table2
+from ..analysis.sensitivity import format_sensitivity, sensitivity_table
+from .common import add_config, params_from_args
 
 
 def parse_speeds(text: str) -> np.ndarray:
@@ -46,27 +49,9 @@ def parse_speeds(text: str) -> np.ndarray:
     return speeds
 
 
-def _set_overrides(items: list[str]) -> dict:
-    """``--set SECTION.KEY=VALUE`` items, parsed exactly as the main CLI does."""
-    from ..cli import _overrides
-
-    return _overrides(items)
-
-
 def _params(args):
-    over = _set_overrides(getattr(args, "set", []) or [])
-    if getattr(args, "length", None) is not None:
-        over["tether.length"] = args.length
-    if getattr(args, "elements", None) is not None:
-        over["tether.n_elements"] = args.elements
-    return load_params(args.config, over or None)
-
-
-def _add_common(p: argparse.ArgumentParser) -> None:
-    """``--config``, ``--set`` and ``--json``, exactly as the main CLI defines them."""
-    from ..cli import _add_config
-
-    _add_config(p)
+    return params_from_args(args, **{"tether.length": getattr(args, "length", None),
+                                     "tether.n_elements": getattr(args, "elements", None)})
 
 
 def _fmt(m) -> str:
@@ -77,8 +62,6 @@ def _fmt(m) -> str:
 
 
 def _stability_text(sweep, dec_ratios: list[dict]) -> str:
-    from .modes import FIGURE9_MODES, SETS
-
     lines = []
     for subset, name in zip(SETS, ("Longitudinal", "Lateral"), strict=True):
         labels = FIGURE9_MODES[subset]
@@ -102,9 +85,6 @@ def _stability_text(sweep, dec_ratios: list[dict]) -> str:
 
 
 def cmd_stability(args) -> int:
-    from .figures import figure9_data, write_figure9
-    from .modes import wind_sweep
-
     params = _params(args)
     speeds = parse_speeds(args.wind)
     sweep = wind_sweep(params, speeds)
@@ -133,16 +113,12 @@ def _json_default(v):
 
 
 def cmd_table2(args) -> int:
-    from .reference import format_table2, table2
-
     rows = table2(_params(args))
     print(json.dumps(rows, indent=1) if args.json else format_table2(rows))
     return 0
 
 
 def cmd_sensitivity(args) -> int:
-    from .sensitivity import format_sensitivity, sensitivity_table
-
     table = sensitivity_table(_params(args))
     print(json.dumps(table, indent=1, default=_json_default) if args.json else format_sensitivity(table))
     return 0
@@ -155,11 +131,11 @@ def add_stability_parsers(subparsers) -> None:
     p.add_argument("--length", type=float, default=None, help="tether length [m] (default: config)")
     p.add_argument("--elements", type=int, default=None, help="tether elements n (default: config)")
     p.add_argument("--plot", metavar="DIR", help="write figure9.png/.csv/.json into DIR")
-    _add_common(p)
+    add_config(p)
     p.set_defaults(func=cmd_stability)
     p = subparsers.add_parser("table2", help="[LN02] Table 2: reference vs linear-model periods")
-    _add_common(p)
+    add_config(p)
     p.set_defaults(func=cmd_table2)
     p = subparsers.add_parser("sensitivity", help="Table 2 periods and damping vs uncertain parameters")
-    _add_common(p)
+    add_config(p)
     p.set_defaults(func=cmd_sensitivity)

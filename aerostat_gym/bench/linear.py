@@ -11,8 +11,8 @@ import time
 
 import numpy as np
 
+from ..analysis.modes import wind_sweep
 from ..params import Params, load_params
-from .modes import wind_sweep
 
 BUDGET_S = 10.0
 
@@ -40,9 +40,3 @@ def bench_sweep(params: Params | None = None, speeds=None, repeats: int = 3) -> 
             "per_speed_ms": 1e3 * med / speeds.size, "all_stable": sweep.all_stable(),
             "budget_s": BUDGET_S, "within_budget": med <= BUDGET_S, "cpu_count": os.cpu_count()}
 
-
-def format_bench(res: dict) -> str:
-    """One line for the bench report."""
-    return (f"linear stability sweep: {res['n_speeds']} speeds, trims included, "
-            f"{res['linear_sweep_s']:.2f} s ({res['per_speed_ms']:.1f} ms/speed; budget "
-            f"{res['budget_s']:g} s on 2 cores; all stable: {res['all_stable']})")

@@ -13,10 +13,19 @@ import time
 import numpy as np
 
 from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
-from .field import build_wind, field_heights, field_times
-from .presets import METHODS, PRESETS, get_preset
-from .spectra import MODELS
-from .stats import COMPONENTS, realised_statistics, row_of, target_psd, welch_psd
+from ..wind.field import build_wind, field_heights, field_times
+from ..wind.presets import METHODS, PRESETS, get_preset
+from ..wind.spectra import MODELS
+from ..wind.stats import (
+    COMPONENTS,
+    ensemble_coherence,
+    log_band_edges,
+    realised_statistics,
+    row_of,
+    target_coherence,
+    target_psd,
+    welch_psd,
+)
 
 
 def add_wind_parser(subparsers) -> argparse.ArgumentParser:
@@ -135,7 +144,6 @@ def _plot(path: str, cfg, wp, fields) -> None:
 
 def _plot_coherence(ax, cfg, wp, wf, k0) -> None:
     """u coherence vs frequency for a few separations, with the IEC target."""
-    from .stats import ensemble_coherence, log_band_edges, target_coherence
 
     dt, U = wp[W_FIELD_DT], wp[W_TAYLOR_U]
     nseg = min(wf.shape[2], 2048)

@@ -1,37 +1,20 @@
-"""State layout and the packed parameter vector of the compiled core.
+"""The packed parameter vector of the compiled core.
 
-State vector (length 6 n + 8, n = number of tether elements)::
-
-    [ r_2 .. r_n        3 (n-1)  inertial positions of the moving tether nodes, top to bottom [m]
-      v_2 .. v_n        3 (n-1)  their inertial velocities [m/s]
-      r_cm              3        aerostat CM position, inertial [m]
-      v_cm              3        aerostat CM velocity, inertial components [m/s]
-      phi, theta, psi   3        Z-Y-X Euler angles (roll, pitch, yaw) [rad]
-      p, q, r           3        body angular rates [rad/s]
-      L                 1        unstretched tether length paid out [m]
-      v_w               1        winch reel-out speed (positive pays line out) [m/s] ]
-
-The first 6 n + 6 entries are the mechanical state of [LN02] (66 for n = 10); the last two are
-the winch. Node numbering follows [LN02]: node 1 is the confluence point, rigidly attached to
-the aerostat (not a state), node n + 1 the anchor at the winch (fixed, not a state).
-
-Control input ``u = [v_set, brake]``: reel-out speed set-point [m/s] and brake flag (1 holds the
-drum). The packed parameter vector is a flat float64 array indexed by the constants below, so
-the compiled functions take plain arrays and numba folds the indices at compile time.
+:func:`pack_params` flattens :class:`aerostat_gym.params.Params` (plus the derived quantities)
+into one float64 array indexed by the ``P_*`` constants below, so the compiled functions take
+plain arrays and numba folds the indices at compile time. The state layout is in
+:mod:`aerostat_gym.physics.state`.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..params import Params
 
 MAX_FINS = 6
-N_INPUTS = 2
-U_SPEED, U_BRAKE = 0, 1
 
 # --- packed parameter vector ----------------------------------------------------------------------
 _FIELDS = [
@@ -146,89 +129,3 @@ def pack_params(params: Params) -> np.ndarray:
     p[P_W_TAU], p[P_W_LMIN], p[P_W_LMAX] = w.speed_time_constant, w.min_length, w.max_length
     p[P_W_FRICTION_V] = 0.01  # m/s: Coulomb friction smoothed as tanh(v / 0.01)
     return p
-
-
-@dataclass(frozen=True)
-class StateLayout:
-    """Named slices into the flat state vector for n tether elements (see module docstring)."""
-
-    n_elements: int
-
-    @property
-    def n_nodes(self) -> int:
-        """Moving tether nodes (excludes the confluence point and the anchor)."""
-        return self.n_elements - 1
-
-    @property
-    def size(self) -> int:
-        return 6 * self.n_elements + 8
-
-    @property
-    def n_mechanical(self) -> int:
-        return 6 * self.n_elements + 6
-
-    def _a(self, k: int) -> int:
-        return 6 * self.n_nodes + k
-
-    @property
-    def node_pos(self) -> slice:
-        return slice(0, 3 * self.n_nodes)
-
-    @property
-    def node_vel(self) -> slice:
-        return slice(3 * self.n_nodes, 6 * self.n_nodes)
-
-    @property
-    def cm_pos(self) -> slice:
-        return slice(self._a(0), self._a(3))
-
-    @property
-    def cm_vel(self) -> slice:
-        return slice(self._a(3), self._a(6))
-
-    @property
-    def euler(self) -> slice:
-        return slice(self._a(6), self._a(9))
-
-    @property
-    def rates(self) -> slice:
-        return slice(self._a(9), self._a(12))
-
-    @property
-    def winch_length(self) -> int:
-        return self._a(12)
-
-    @property
-    def winch_speed(self) -> int:
-        return self._a(13)
-
-    @property
-    def mechanical(self) -> slice:
-        return slice(0, self.n_mechanical)
-
-    def names(self) -> list[str]:
-        """Human-readable name of every state entry (node k counts from the top, k = 2..n)."""
-        out = []
-        nodes = range(2, self.n_elements + 1)
-        out += [f"{c}{k}" for k in nodes for c in "xyz"]
-        out += [f"{c}dot{k}" for k in nodes for c in "xyz"]
-        out += ["x_cm", "y_cm", "z_cm", "u_cm", "v_cm", "w_cm", "phi", "theta", "psi", "p", "q", "r"]
-        return out + ["L", "v_w"]
-
-    def longitudinal_indices(self) -> np.ndarray:
-        """[LN02] longitudinal set: x, z and their rates for every node (aerostat last), theta, q.
-
-        Order: x_2..x_n, x_cm, xdot_2..xdot_cm, z_2..z_cm, zdot_2..zdot_cm, theta, q
-        (4 n + 2 states).
-        """
-        n = self.n_nodes
-        pos = lambda c: [3 * k + c for k in range(n)] + [self._a(c)]  # noqa: E731
-        vel = lambda c: [3 * n + 3 * k + c for k in range(n)] + [self._a(3 + c)]  # noqa: E731
-        return np.array(pos(0) + vel(0) + pos(2) + vel(2) + [self._a(7), self._a(10)])
-
-    def lateral_indices(self) -> np.ndarray:
-        """[LN02] lateral set: y and its rate for every node, phi, p, psi, r (2 n + 4 states)."""
-        n = self.n_nodes
-        ys = [3 * k + 1 for k in range(n)] + [self._a(1)]
-        vys = [3 * n + 3 * k + 1 for k in range(n)] + [self._a(4)]
-        return np.array(ys + vys + [self._a(6), self._a(9), self._a(8), self._a(11)])

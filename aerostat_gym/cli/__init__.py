@@ -1,0 +1,44 @@
+"""Command-line interface: ``aerostat-gym <command> [options]``.
+
+Commands: ``trim`` (equilibrium summary), ``params`` (every parameter with its unit and status),
+``bench`` (speed and accuracy figures), ``wind`` (turbulence statistics), ``stability``,
+``table2`` and ``sensitivity`` (linear stability analysis), ``train``, ``evaluate`` and ``demo``
+(winch-control agents). Errors in user input print one clear line and exit with status 2.
+
+One module per group of commands (``model``, ``wind``, ``stability``, ``agents``), each with an
+``add_*_parsers`` function; ``common`` holds the options they share.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..params import ParameterError
+from .agents import add_agent_parsers
+from .model import add_model_parsers
+from .stability import add_stability_parsers
+from .wind import add_wind_parser
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="aerostat-gym", description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    add_model_parsers(sub)
+    add_wind_parser(sub)
+    add_stability_parsers(sub)
+    add_agent_parsers(sub)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (ParameterError, ValueError, RuntimeError) as exc:
+        print(f"aerostat-gym {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,174 @@
+"""The task's configuration: the environment's constructor arguments, validated once
+(:class:`TaskConfig`), with the perturbation presets and the domain-randomisation ranges.
+The episode start built from it is :mod:`aerostat_gym.envs.episodes`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..params import Params, apply_overrides, load_params
+from ..sim import INTEGRATORS
+from ..wind.presets import resolve_turbulence
+from . import reward
+
+#: Perturbation presets: maximum along-wind swing and lateral displacement of the aerostat [m]
+#: (a rigid rotation of aerostat and tether about the winch), pitch kick about the confluence
+#: point [rad], and a 1 - cos gust along the wind drawn with this probability. Amplitudes are
+#: drawn uniformly in [-max, max]; with "fixed": True they are applied as given (signed).
+PERTURBATIONS = {
+    "none": {"swing": 0.0, "lateral": 0.0, "pitch": 0.0, "gust_probability": 0.0,
+             "fixed": False},
+    "displacement": {"swing": 10.0, "lateral": 5.0, "pitch": 0.05, "gust_probability": 0.0},
+    "gust": {"swing": 0.0, "lateral": 0.0, "pitch": 0.0, "gust_probability": 1.0},
+    "mixed": {"swing": 10.0, "lateral": 5.0, "pitch": 0.05, "gust_probability": 0.5},
+}
+GUST_DEFAULTS = {"gust_amplitude": (1.0, 4.0), "gust_duration": (5.0, 20.0),
+                 "gust_onset": (0.0, 30.0)}
+#: Estimated parameters randomised by ``randomize=True`` (relative half-ranges).
+DEFAULT_RANDOMIZATION = {
+    "aerostat.Ixx": 0.3, "aerostat.Iyy": 0.3, "aerostat.Izz": 0.3, "hull.Cdc": 0.2,
+    "hull.eta_k": 0.2, "fins.CL_alpha": 0.2, "tether.Cd_normal": 0.2, "aerostat.mass": 0.03,
+}
+
+
+class TaskError(ValueError):
+    """An invalid environment argument (the message names it and the value)."""
+
+
+def _range(name, value, lo_min=0.0):
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise TaskError(f"{name} must be a (low, high) pair, got {value!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo_min <= lo <= hi):
+        raise TaskError(f"{name} must satisfy {lo_min} <= low <= high (finite), got {value!r}")
+    return lo, hi
+
+
+def _positive(name, value):
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        raise TaskError(f"{name} must be a finite number > 0, got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class TaskConfig:
+    """Validated environment arguments (see :class:`aerostat_gym.envs.TetheredAerostatEnv`)."""
+
+    wind_speed: tuple = (3.0, 15.0)
+    turbulence: object = "moderate"
+    perturbation: object = "mixed"
+    tether_length: float | None = None
+    n_elements: int | None = None
+    integrator: str = "semi-implicit"
+    control_step: float = 0.2
+    params: object = None
+    overrides: dict | None = None
+    randomize: object = None
+    obs_noise: float = 0.0
+    reward_weights: dict | None = None
+    reward_fn: object = None
+    observation: str = "standard"
+    wind_bank_size: int = 8
+    wind_bank_seed: int = 0
+    resolved: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def __post_init__(self):
+        r = self.resolved
+        r["wind_speed"] = _range("wind_speed", self.wind_speed)
+        try:
+            r["turbulence"] = resolve_turbulence(self.turbulence)
+        except (TypeError, ValueError) as exc:
+            raise TaskError(f"turbulence: {exc}") from None
+        r["perturbation"] = perturbation(self.perturbation)
+        if self.integrator not in INTEGRATORS:
+            raise TaskError(f"unknown integrator {self.integrator!r}; choose one of {INTEGRATORS}")
+        dt = _positive("control_step", self.control_step)
+        if dt > 1.0:
+            raise TaskError(f"control_step must be <= 1 s (the axial mode is ~3 s), got {dt!r}")
+        if self.observation not in ("standard", "full"):
+            raise TaskError(f"unknown observation {self.observation!r}; choose 'standard' or "
+                            "'full'")
+        if not (isinstance(self.obs_noise, (int, float)) and math.isfinite(self.obs_noise)
+                and self.obs_noise >= 0):
+            raise TaskError(f"obs_noise must be a finite number >= 0, got {self.obs_noise!r}")
+        try:
+            r["weights"] = reward.weights_vector(self.reward_weights)
+            reward.check_reward_fn(self.reward_fn)
+        except ValueError as exc:
+            raise TaskError(str(exc)) from None
+        if not (isinstance(self.wind_bank_size, int) and self.wind_bank_size >= 1):
+            raise TaskError(f"wind_bank_size must be an integer >= 1, got {self.wind_bank_size!r}")
+        r["params"] = self._params()
+        r["randomize"] = self._randomize(r["params"])
+
+    def _params(self) -> Params:
+        p = self.params
+        if p is None or isinstance(p, (str, Path)):
+            p = load_params(p)
+        elif not isinstance(p, Params):
+            raise TaskError(f"params must be a Params, a TOML path or None, got {type(p).__name__}")
+        over = dict(self.overrides or {})
+        if self.tether_length is not None:
+            over["tether.length"] = self.tether_length
+        if self.n_elements is not None:
+            over["tether.n_elements"] = self.n_elements
+        return apply_overrides(p, over) if over else p
+
+    def _randomize(self, params: Params) -> dict:
+        if self.randomize is None or self.randomize is False:
+            return {}
+        spec = DEFAULT_RANDOMIZATION if self.randomize is True else self.randomize
+        if not isinstance(spec, dict):
+            raise TaskError(f"randomize must be None, True or a dict, got {self.randomize!r}")
+        for key, rel in spec.items():
+            if not (isinstance(rel, (int, float)) and 0 <= rel < 1):
+                raise TaskError(f"randomize[{key!r}] must be a relative half-range in [0, 1), "
+                                f"got {rel!r}")
+            apply_overrides(params, {key: get_parameter(params, key)})  # names an unknown key
+        return dict(spec)
+
+    @property
+    def params_resolved(self) -> Params:
+        return self.resolved["params"]
+
+
+def get_parameter(params: Params, key: str):
+    """The value of ``section.key`` in a parameter set (TaskError naming an unknown key)."""
+    sec, _, name = key.partition(".")
+    try:
+        return getattr(getattr(params, sec), name)
+    except AttributeError:
+        raise TaskError(f"unknown parameter {key!r} in randomize") from None
+
+
+def perturbation(spec) -> dict:
+    """A validated perturbation dict from a preset name or a (partial) dict."""
+    if isinstance(spec, str):
+        if spec not in PERTURBATIONS:
+            raise TaskError(f"unknown perturbation {spec!r}; choose one of {list(PERTURBATIONS)}"
+                            " or pass a dict")
+        spec = PERTURBATIONS[spec]
+    if not isinstance(spec, dict):
+        raise TaskError(f"perturbation must be a preset name or a dict, got {spec!r}")
+    out = {**PERTURBATIONS["none"], **GUST_DEFAULTS}
+    unknown = sorted(set(spec) - set(out))
+    if unknown:
+        raise TaskError(f"unknown perturbation key(s) {unknown}; known: {sorted(out)}")
+    out.update(spec)
+    for k in ("swing", "lateral", "pitch"):
+        ok = isinstance(out[k], (int, float)) and math.isfinite(out[k])
+        if not ok or (out[k] < 0 and not out["fixed"]):
+            raise TaskError(f"perturbation {k} must be a finite number (>= 0 unless fixed), "
+                            f"got {out[k]!r}")
+    if not isinstance(out["fixed"], bool):
+        raise TaskError(f"perturbation fixed must be True or False, got {out['fixed']!r}")
+    if not 0 <= out["gust_probability"] <= 1:
+        raise TaskError(f"perturbation gust_probability must be in [0, 1], got "
+                        f"{out['gust_probability']!r}")
+    for k in GUST_DEFAULTS:
+        out[k] = _range(f"perturbation {k}", out[k])
+    return out

@@ -1,0 +1,209 @@
+"""The episode start: trim table, turbulence bank, perturbation and domain randomisation.
+
+Everything random at an episode start is drawn from the one generator passed in, in a fixed
+order, so a seed fixes the episode and environment i of a batch matches a single environment
+seeded the same way.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis.trim import Equilibrium, find_equilibrium
+from ..params import Params, apply_overrides, dumps_toml
+from ..physics.core import euler_angles, rotation_matrix
+from ..physics.packing import pack_params
+from ..physics.state import StateLayout
+from ..physics.wind import mean_wind, set_advection, set_field, set_gust
+from ..sim import Model
+from ..wind.presets import TurbulenceConfig
+from ..wind.synthesis import fft_length, veers_field
+from .config import TaskConfig, TaskError, get_parameter, perturbation
+
+WIND_GRID = 0.1  # [m/s] episode wind speeds are drawn on this grid, where the trims are exact
+FIELD_DXI = 1.0  # [m] along-wind step of the turbulence bank (0.07-0.33 s at 15-3 m/s)
+DEFAULT_HORIZON = 120.0  # [s] field coverage when the episode length is not known
+
+
+# --- trims, shared between environments with the same parameters -------------------------------
+
+_TRIMS: dict = {}
+
+
+class TrimTable:
+    """Exact trims on the wind-speed grid of the task, computed once per parameter set by
+    continuation in wind speed and shared by every environment in the process."""
+
+    def __init__(self, params: Params, lo: float, hi: float):
+        self.params = params
+        self.speeds = np.round(np.arange(round(lo / WIND_GRID), round(hi / WIND_GRID) + 1)
+                               * WIND_GRID, 10)
+        key = (dumps_toml(params), float(self.speeds[0]), float(self.speeds[-1]))
+        if key not in _TRIMS:
+            _TRIMS[key] = _build_trims(params, self.speeds)
+        self.states, self.tensions = _TRIMS[key]
+
+    def equilibrium(self, k: int) -> Equilibrium:
+        return Equilibrium(self.states[k].copy(), float(self.speeds[k]), self.params, 0.0, 0, {})
+
+
+def _build_trims(params: Params, speeds: np.ndarray):
+    model = Model(params, 0.0)
+    eq = find_equilibrium(params, float(speeds[0]))
+    states, tensions = [], []
+    for s in speeds:
+        eq = find_equilibrium(params, float(s), guess=eq, max_step=WIND_GRID)
+        states.append(eq.x)
+        tensions.append(model.end_tensions(eq.x)[1])
+    return np.array(states), np.array(tensions)
+
+
+# --- turbulence bank ---------------------------------------------------------------------------
+
+_BANKS: dict = {}
+
+
+def turbulence_bank(cfg: TurbulenceConfig, size: int, seed: int, length: float) -> np.ndarray:
+    """``size`` frozen turbulence fields on an along-wind grid of step FIELD_DXI [m], shape
+    (size, n_heights, n_xi, 3); cached per (config, size, seed, length).
+
+    The field is generated in space (Taylor's frozen turbulence): the von Karman / Dryden
+    spectra and the IEC coherence depend on frequency and wind speed only through the
+    wavenumber f / U, so a field synthesised at U = 1 m/s with time step FIELD_DXI is the
+    spatial field, valid for any mean speed once read with time step FIELD_DXI / U_a.
+    """
+    n = fft_length(length / FIELD_DXI + 1.0)
+    key = (cfg, size, seed, n)
+    if key not in _BANKS:
+        rng = np.random.default_rng(seed)
+        spatial = cfg.replace(dt=FIELD_DXI)
+        _BANKS[key] = np.stack([veers_field(spatial, 1.0, n, rng) for _ in range(size)])
+    return _BANKS[key]
+
+
+def field_length_needed(cfg: TurbulenceConfig, u_max: float, horizon: float) -> float:
+    """Along-wind extent [m] a bank field needs to serve one episode at speeds up to u_max,
+    plus as much again for random start offsets."""
+    return 2.0 * (u_max * horizon + cfg.downwind_extent + cfg.upwind_extent) + 100.0
+
+
+# --- episode start -----------------------------------------------------------------------------
+
+
+@dataclass
+class Episode:
+    """What one episode start produced (the batch copies it into its arrays)."""
+
+    x0: np.ndarray
+    x_trim: np.ndarray
+    tension_trim: float
+    p: np.ndarray
+    wp: np.ndarray
+    field_index: int
+    wind_speed: float
+    params: Params
+    info: dict
+
+
+def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, horizon: float,
+                   rng: np.random.Generator, options: dict | None = None) -> Episode:
+    """Draw one episode start: wind speed, parameters, trim, turbulence offset, perturbation.
+
+    ``options`` (from ``reset(options=...)``) may fix ``wind_speed`` (snapped to the 0.1 m/s
+    grid) and ``perturbation`` (a preset name or dict) for this episode.
+    """
+    opts = dict(options or {})
+    unknown = sorted(set(opts) - {"wind_speed", "perturbation"})
+    if unknown:
+        raise TaskError(f"unknown reset option(s) {unknown}; known: ['perturbation', 'wind_speed']")
+    pert = perturbation(opts["perturbation"]) if "perturbation" in opts else \
+        task.resolved["perturbation"]
+    k = _speed_index(trims, opts.get("wind_speed"), rng)
+    U = float(trims.speeds[k])
+    params, x_trim = _parameters(task, trims, k, rng)
+    tension = (trims.tensions[k] if params is trims.params
+               else Model(params, U).end_tensions(x_trim)[1])
+    cfg = task.resolved["turbulence"]
+    wp = mean_wind(params.wind, U)
+    ua = set_advection(wp, cfg.reference_height, cfg.min_advection_speed)
+    field_index, offset = _field(cfg, bank_shape, ua, horizon, wp, rng)
+    x0, info = _perturb(x_trim, params, pert, wp, ua, rng)
+    info.update({"wind_speed": U, "field_index": field_index, "field_offset_m": offset})
+    return Episode(x0, x_trim, float(tension), pack_params(params), wp, field_index, U, params,
+                   info)
+
+
+def _speed_index(trims: TrimTable, fixed, rng) -> int:
+    if fixed is None:
+        return int(rng.integers(len(trims.speeds)))
+    k = int(np.argmin(np.abs(trims.speeds - float(fixed))))
+    if abs(trims.speeds[k] - float(fixed)) > WIND_GRID / 2 + 1e-9:
+        raise TaskError(f"reset option wind_speed={fixed!r} is outside the task's range "
+                        f"[{trims.speeds[0]}, {trims.speeds[-1]}] m/s")
+    return k
+
+
+def _parameters(task: TaskConfig, trims: TrimTable, k: int, rng) -> tuple[Params, np.ndarray]:
+    """Nominal parameters and trim, or randomised ones re-trimmed from the nominal trim."""
+    spec = task.resolved["randomize"]
+    if not spec:
+        return trims.params, trims.states[k].copy()
+    base = trims.params
+    over = {key: get_parameter(base, key) * (1.0 + rng.uniform(-rel, rel)) for key, rel in spec.items()}
+    params = apply_overrides(base, over)
+    eq = find_equilibrium(params, float(trims.speeds[k]), guess=trims.equilibrium(k),
+                          max_step=WIND_GRID)
+    return params, eq.x
+
+
+def _field(cfg, bank_shape, ua, horizon, wp, rng) -> tuple[int, float]:
+    """Pick a bank field and a start offset; record its grid in wp (time step dxi / U_a)."""
+    if cfg.is_off:
+        return 0, 0.0
+    n_fields, nz, n_xi, _ = bank_shape
+    index = int(rng.integers(n_fields))
+    span = (n_xi - 1) * FIELD_DXI
+    lo = cfg.downwind_extent
+    hi = span - ua * horizon - cfg.upwind_extent
+    if hi < lo:
+        raise TaskError(f"the turbulence bank ({span:.0f} m) is too short for {horizon:.0f} s at "
+                        f"U_a = {ua:.1f} m/s")
+    offset = float(rng.uniform(lo, hi))
+    set_field(wp, cfg.z_min, cfg.dz, -offset / ua, FIELD_DXI / ua, cfg.downwind_extent,
+              cfg.upwind_extent)
+    return index, offset
+
+
+def _perturb(x_trim, params, pert, wp, ua, rng) -> tuple[np.ndarray, dict]:
+    """Initial state: the trim swung rigidly about the winch (no element stretched), then the
+    aerostat pitched about its confluence point (the top element keeps its length); and a
+    1 - cos gust along the wind with probability gust_probability."""
+    lay = StateLayout(params.tether.n_elements)
+    x = x_trim.copy()
+    draw = (lambda: 1.0) if pert["fixed"] else (lambda: rng.uniform(-1.0, 1.0))
+    swing = draw() * pert["swing"]
+    lateral = draw() * pert["lateral"]
+    pitch = draw() * pert["pitch"]
+    height = x[lay.cm_pos][2]
+    Rs = rotation_matrix(0.0, swing / height, 0.0) @ rotation_matrix(-lateral / height, 0.0, 0.0)
+    nodes = x[lay.node_pos].reshape(-1, 3)
+    x[lay.node_pos] = (nodes @ Rs.T).ravel()
+    R = Rs @ rotation_matrix(*x[lay.euler])
+    leash = np.array(params.derived.leash_position)
+    conf = Rs @ x[lay.cm_pos] + R @ leash
+    phi, theta, psi = euler_angles(R)
+    theta += pitch
+    x[lay.euler] = (phi, theta, psi)
+    x[lay.cm_pos] = conf - rotation_matrix(phi, theta, psi) @ leash
+    info = {"swing_m": swing, "lateral_m": lateral, "pitch_rad": pitch,
+            "gust_amplitude_m_s": 0.0, "gust_duration_s": 0.0, "gust_onset_s": 0.0}
+    if rng.uniform() < pert["gust_probability"]:
+        amp = rng.uniform(*pert["gust_amplitude"])
+        dur = rng.uniform(*pert["gust_duration"])
+        onset = rng.uniform(*pert["gust_onset"])
+        set_gust(wp, (amp, 0.0, 0.0), dur * ua, onset)
+        info.update(gust_amplitude_m_s=amp, gust_duration_s=dur, gust_onset_s=onset)
+    return x, info
+
