@@ -1,16 +1,10 @@
 """The yaw-departure figures of the README ("Known limitation: yaw departures at large
-sideslip"), measured by scripts/sideslip_departures.py."""
-
-import importlib.util
-from pathlib import Path
+sideslip"), measured by aerostat_gym.analysis.sideslip (scripts/sideslip_departures.py)."""
 
 import numpy as np
 import pytest
 
-_spec = importlib.util.spec_from_file_location(
-    "sideslip_departures", Path(__file__).resolve().parents[1] / "scripts" / "sideslip_departures.py")
-script = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(script)
+from aerostat_gym.analysis import sideslip as script
 
 
 def test_sideslip_closed_form():
