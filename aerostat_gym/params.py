@@ -39,8 +39,15 @@ POSITIVE, NONNEG, ANY, INT_GE1, STALL, VEC3, COEFFS = (
 )
 
 
-def _f(unit: str, status: str, check: str = ANY, doc: str = "", default: Any = dataclasses.MISSING):
-    meta = {"unit": unit, "status": status, "check": check, "doc": doc}
+#: Upper bound on tether.n_elements: a sanity bound on memory and step size; the trim's cost
+#: grows gently with n (its Jacobian is built by banded finite differences, see
+#: aerostat_gym.analysis.trim), so this is not what limits it.
+MAX_ELEMENTS = 1000
+
+
+def _f(unit: str, status: str, check: str = ANY, doc: str = "", default: Any = dataclasses.MISSING,
+       size: int | None = None):
+    meta = {"unit": unit, "status": status, "check": check, "doc": doc, "size": size}
     if default is dataclasses.MISSING:
         return field(metadata=meta)
     if isinstance(default, (list, tuple)):
@@ -121,8 +128,10 @@ class TetherParams:
     damping_ratio: float = _f("-", "SOURCED", NONNEG, "damping ratio zeta, b = zeta b_c")
     strength: float = _f("N", "SOURCED", POSITIVE, "breaking strength")
     Cd_normal: float = _f("-", "ESTIMATE", NONNEG, "normal drag coefficient")
-    loading_fn: tuple = _f("-", "ESTIMATE", COEFFS, "f_n coefficients of [1, cos, sin, cos2, sin2]")
-    loading_ft: tuple = _f("-", "ESTIMATE", COEFFS, "f_t polynomial coefficients in phi, ascending")
+    loading_fn: tuple = _f("-", "ESTIMATE", COEFFS, "f_n coefficients of [1, cos, sin, cos2, sin2]",
+                           size=5)
+    loading_ft: tuple = _f("-", "ESTIMATE", COEFFS, "f_t polynomial coefficients in phi, ascending",
+                           size=6)
     anchor_position: tuple = _f("m", "ESTIMATE", VEC3, "winch / anchor position (inertial)")
 
 
@@ -221,16 +230,23 @@ def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
             raise ParameterError(f"{name} must be finite, got {value!r}")
         return value
     if check == COEFFS:
+        size = f.metadata["size"]
         if not (isinstance(value, (list, tuple)) and value and all(map(_is_number, value))):
-            raise ParameterError(f"{name} must be a non-empty list of numbers, got {value!r}")
-        return tuple(float(v) for v in value)
+            raise ParameterError(f"{name} must be a list of {size} numbers, got {value!r}")
+        if len(value) != size:
+            raise ParameterError(f"{name} needs {size} coefficients, got {len(value)}: {value!r}")
+        value = tuple(float(v) for v in value)
+        bad = [i for i, v in enumerate(value) if not math.isfinite(v)]
+        if bad:
+            raise ParameterError(f"{name} must be finite, got {value[bad[0]]!r} at index {bad[0]}")
+        return value
     if f.type in ("str", str):
         if not isinstance(value, str):
             raise ParameterError(f"{name} must be a string, got {value!r}")
         return value
     if check == INT_GE1:
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise ParameterError(f"{name} must be an integer >= 1, got {value!r}")
+        if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_ELEMENTS:
+            raise ParameterError(f"{name} must be an integer in [1, {MAX_ELEMENTS}], got {value!r}")
         return int(value)
     if not _is_number(value):
         raise ParameterError(f"{name} must be a number, got {value!r}")
@@ -292,6 +308,39 @@ def _cross_checks(p: Params) -> None:
             f"aerostat.mass = {p.aerostat.mass} kg gives no net lift (buoyancy {d.buoyancy:.1f} N "
             f"<= weight {p.aerostat.mass * p.environment.g:.1f} N)"
         )
+    _feasibility(p, d)
+
+
+def _feasibility(p: Params, d: Derived) -> None:
+    """Constraints across sections without which no episode can run: each error names both
+    fields and their numbers."""
+    t, w = p.tether, p.winch
+    if not w.min_length <= t.length <= w.max_length:
+        raise ParameterError(
+            f"tether.length ({t.length} m) lies outside the winch's length limits "
+            f"[winch.min_length, winch.max_length] = [{w.min_length}, {w.max_length}] m")
+    if w.total_line_length < w.max_length:
+        raise ParameterError(
+            f"winch.total_line_length ({w.total_line_length} m) must be >= winch.max_length "
+            f"({w.max_length} m): the drum cannot pay out more line than it holds")
+    if d.net_lift <= d.tether_weight:
+        raise ParameterError(
+            f"the net lift ({d.net_lift:.1f} N, aerostat.volume and aerostat.mass) does not "
+            f"exceed the weight of tether.length = {t.length} m of tether ({d.tether_weight:.1f} N, "
+            "tether.diameter and tether.density): the aerostat cannot lift its tether")
+    if d.net_lift >= t.strength:
+        raise ParameterError(
+            f"the net lift ({d.net_lift:.1f} N, aerostat.volume and aerostat.mass), the tether "
+            f"tension in still air, is not below tether.strength ({t.strength} N): the tether "
+            "breaks at zero wind")
+    if w.safe_working_load > t.strength:
+        raise ParameterError(
+            f"winch.safe_working_load ({w.safe_working_load} N) exceeds tether.strength "
+            f"({t.strength} N)")
+    if w.slack_tension >= w.safe_working_load:
+        raise ParameterError(
+            f"winch.slack_tension ({w.slack_tension} N) must be below winch.safe_working_load "
+            f"({w.safe_working_load} N)")
 
 
 def params_from_dict(data: dict) -> Params:

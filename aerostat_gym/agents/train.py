@@ -76,6 +76,15 @@ def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize):
     return venv
 
 
+def _count(name: str, value) -> int:
+    """A step or environment count: an integer >= 1 (0 and negatives are refused, not read as
+    'use the default')."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value) \
+            or value < 1:
+        raise TrainingError(f"{name} must be an integer >= 1, got {value!r}")
+    return int(value)
+
+
 def train(algo: str, config: str | Path | None = None, timesteps: int | None = None,
           n_envs: int | None = None, seed: int = 0, run_dir: str | Path | None = None,
           resume: str | Path | None = None, progress_bar: bool = True, threads: int | None = None,
@@ -86,8 +95,8 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     from stable_baselines3.common.utils import set_random_seed
 
     hp = load_hyperparams(algo, config)
-    n_envs = int(n_envs or hp.get("n_envs", 8))
-    timesteps = int(timesteps or hp.get("n_timesteps", 1e6))
+    n_envs = _count("n_envs", hp.get("n_envs", 8) if n_envs is None else n_envs)
+    timesteps = _count("timesteps", hp.get("n_timesteps", 1e6) if timesteps is None else timesteps)
     env_kwargs = dict(hp.get("env_kwargs") or {})
     run = Path(run_dir or f"runs/train/{algo}_seed{seed}_{time.strftime('%Y%m%d-%H%M%S')}")
     run.mkdir(parents=True, exist_ok=True)

@@ -5,6 +5,14 @@
 aerostat (force in body axes, moment about the CM) vanish. Newton's method with a central
 finite-difference Jacobian and a minimum-norm least-squares step (at zero wind the yaw angle
 is undetermined; the min-norm step leaves it where it is) and a backtracking line search.
+
+The cost grows gently with the number of elements n. Node j's generalized force depends only
+on nodes j - 1, j, j + 1 (and the top node's on the aerostat), so the Jacobian is banded with
+a dense aerostat border: perturbing every third node together gives all its node columns in 9
+pairs of evaluations, plus 6 for the aerostat, whatever n (a column-by-column Jacobian costs
+6 n + 12 evaluations). Beyond ``DENSE_UNKNOWNS`` unknowns the Newton step is solved by sparse
+LU (O(n)) instead of the dense least-squares solve (O(n^3)), falling back to it when the
+sparse matrix is singular.
 The start is the exact zero-wind solution (a vertical tether with each element stretched by
 its own tension), continued in wind speed in steps of at most ``max_step`` m/s.
 """
@@ -15,6 +23,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse
+import scipy.sparse.linalg
 
 from ..params import Params, load_params
 from ..physics.core import rotation_matrix
@@ -22,6 +32,8 @@ from ..physics.wind import pack_wind
 from ..sim import Model
 
 REL_TOL = 1e-9
+#: Largest Newton system solved densely (min-norm least squares); larger ones use sparse LU.
+DENSE_UNKNOWNS = 100
 
 
 class TrimError(RuntimeError):
@@ -89,23 +101,69 @@ def zero_wind_state(params: Params, length: float | None = None) -> np.ndarray:
     return x
 
 
+def _column_groups(model: Model, n_unknowns: int) -> list[np.ndarray]:
+    """Positions (within the unknowns) perturbed together: coordinate k of every third node,
+    then each aerostat unknown alone."""
+    n_nodes = model.layout.n_nodes
+    groups = [np.array([3 * j + k for j in range(c, n_nodes, 3)], dtype=np.int64)
+              for c in range(min(3, n_nodes)) for k in range(3)]
+    groups += [np.array([c]) for c in range(3 * n_nodes, n_unknowns)]
+    return [g for g in groups if g.size]
+
+
+def _rows_of(model: Model, col: int, n_rows: int) -> np.ndarray:
+    """Residual rows that unknown ``col`` can change: its node and the two neighbours, plus
+    the aerostat rows for the top node; every row for an aerostat unknown."""
+    n_nodes = model.layout.n_nodes
+    if col >= 3 * n_nodes:
+        return np.arange(n_rows)
+    j = col // 3
+    rows = np.arange(3 * max(j - 1, 0), 3 * min(j + 2, n_nodes))
+    return np.concatenate([rows, np.arange(3 * n_nodes, n_rows)]) if j == 0 else rows
+
+
+def _jacobian(model: Model, x: np.ndarray, idx: np.ndarray, steps: np.ndarray, r_size: int):
+    """Central finite-difference Jacobian by column groups (module docstring)."""
+    J = np.zeros((r_size, idx.size))
+    for group in _column_groups(model, idx.size):
+        xp, xm = x.copy(), x.copy()
+        xp[idx[group]] += steps[group]
+        xm[idx[group]] -= steps[group]
+        diff = _residual(model, xp) - _residual(model, xm)
+        for col in group:
+            rows = _rows_of(model, int(col), r_size)
+            J[rows, col] = diff[rows] / (2 * steps[col])
+    return J
+
+
+def _newton_step(J: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Minimum-norm least-squares step for small systems, sparse LU for large ones."""
+    if J.shape[1] > DENSE_UNKNOWNS:
+        try:
+            dz = scipy.sparse.linalg.spsolve(scipy.sparse.csc_matrix(J), -r)
+            if np.all(np.isfinite(dz)):
+                return dz
+        except RuntimeError:  # exactly singular: fall back to the min-norm solve
+            pass
+    return np.linalg.lstsq(J, -r, rcond=1e-13)[0]
+
+
 def _newton(model: Model, x: np.ndarray, tol: float, max_iter: int) -> tuple[np.ndarray, float, int]:
     idx = _unknown_index(model)
     scale = model.params.derived.buoyancy
     steps = np.where(np.isin(idx, np.arange(model.layout.euler.start, model.layout.euler.stop)),
                      1e-7, 1e-5)
     r = _residual(model, x)
+    if not np.all(np.isfinite(r)):
+        return x, math.inf, 0
     rel = np.max(np.abs(r)) / scale
     for it in range(max_iter):
         if rel <= tol:
             return x, rel, it
-        J = np.empty((r.size, idx.size))
-        for k, (i, h) in enumerate(zip(idx, steps, strict=True)):
-            xp, xm = x.copy(), x.copy()
-            xp[i] += h
-            xm[i] -= h
-            J[:, k] = (_residual(model, xp) - _residual(model, xm)) / (2 * h)
-        dz = np.linalg.lstsq(J, -r, rcond=1e-13)[0]
+        J = _jacobian(model, x, idx, steps, r.size)
+        if not np.all(np.isfinite(J)):
+            return x, rel, it
+        dz = _newton_step(J, r)
         lam = 1.0
         for _ in range(30):
             xn = x.copy()
@@ -204,3 +262,33 @@ def trim_summary(model: Model, x: np.ndarray, wind_speed: float) -> dict:
         "elevation_at_winch_deg": elevation,
         "tether_length_m": float(x[lay.winch_length]),
     }
+
+
+class TrimLimitError(ValueError):
+    """A trim the configured tether cannot hold (its tension is above the tether strength)."""
+
+
+def limit_warnings(params: Params, summary: dict) -> list[str]:
+    """What the configured winch and tether cannot do at this trim, as warnings.
+
+    Raises :class:`TrimLimitError` when the trim's largest tension reaches the tether's breaking
+    strength (no such equilibrium exists: the tether breaks). Warns when the winch-end tension
+    exceeds the motor's force limit (the winch holds on its brake and cannot reel in) or the
+    safe working load (the over-tension event fires at rest).
+    """
+    T_w = summary["winch_tension_N"]
+    T_max = max(summary["top_tension_N"], T_w)
+    U = summary["wind_speed_m_s"]
+    t, w = params.tether, params.winch
+    if T_max >= t.strength:
+        raise TrimLimitError(f"at U = {U:g} m/s the trim tension {T_max:.0f} N exceeds "
+                             f"tether.strength = {t.strength:.0f} N: the tether breaks")
+    out = []
+    if T_w > w.max_motor_force:
+        out.append(f"at U = {U:g} m/s the winch tension {T_w:.0f} N exceeds "
+                   f"winch.max_motor_force = {w.max_motor_force:.0f} N: the winch holds on its "
+                   "brake and cannot reel in")
+    if T_max > w.safe_working_load:
+        out.append(f"at U = {U:g} m/s the trim tension {T_max:.0f} N exceeds "
+                   f"winch.safe_working_load = {w.safe_working_load:.0f} N")
+    return out

@@ -16,13 +16,14 @@ import sys
 
 from ..params import ParameterError
 from .agents import add_agent_parsers
+from .common import OneLineParser
 from .model import add_model_parsers
 from .stability import add_stability_parsers
 from .wind import add_wind_parser
 
 
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="aerostat-gym", description=__doc__.split("\n")[0])
+    ap = OneLineParser(prog="aerostat-gym", description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
     add_model_parsers(sub)
     add_wind_parser(sub)
@@ -35,7 +36,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (ParameterError, ValueError, RuntimeError) as exc:
+    except (ParameterError, ValueError, RuntimeError, OSError) as exc:
         print(f"aerostat-gym {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

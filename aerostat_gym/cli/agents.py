@@ -13,6 +13,7 @@ from ..agents.train import ALGOS, train
 from ..analysis.modes import analyse
 from ..analysis.trim import find_equilibrium
 from ..params import load_params
+from .common import existing_file, nonneg_float, positive_int
 
 SHIPPED_POLICY = "agents/ppo_tethered_aerostat.zip"
 
@@ -20,14 +21,16 @@ SHIPPED_POLICY = "agents/ppo_tethered_aerostat.zip"
 def add_train_parser(sub) -> None:
     p = sub.add_parser("train", help="train a winch-control policy with Stable-Baselines3")
     p.add_argument("--algo", choices=ALGOS, default="ppo")
-    p.add_argument("--config", help="hyperparameter YAML (default agents/hyperparams/ALGO.yml)")
-    p.add_argument("--timesteps", type=int, help="total environment steps (default: the YAML)")
-    p.add_argument("--n-envs", type=int, help="parallel environments (default: the YAML)")
+    p.add_argument("--config", type=existing_file,
+                   help="hyperparameter YAML (default agents/hyperparams/ALGO.yml)")
+    p.add_argument("--timesteps", type=positive_int,
+                   help="total environment steps (default: the YAML)")
+    p.add_argument("--n-envs", type=positive_int, help="parallel environments (default: the YAML)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--run-dir", help="output directory (default runs/train/ALGO_seedS_TIME)")
-    p.add_argument("--resume", help="checkpoint .zip to continue from")
-    p.add_argument("--eval-freq", type=int, help="evaluate on the suite every N steps")
-    p.add_argument("--threads", type=int, help="torch threads (default: torch's)")
+    p.add_argument("--resume", type=existing_file, help="checkpoint .zip to continue from")
+    p.add_argument("--eval-freq", type=positive_int, help="evaluate on the suite every N steps")
+    p.add_argument("--threads", type=positive_int, help="torch threads (default: torch's)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=_train_command)
 
@@ -66,7 +69,8 @@ def _evaluate_command(args) -> int:
 def add_demo_parser(sub) -> None:
     p = sub.add_parser("demo", help="the main job: trim, stability summary, shipped policy vs "
                                     "baselines on the tiny suite, report in runs/demo/")
-    p.add_argument("--wind", type=float, default=10.0, help="wind speed of the summary [m/s]")
+    p.add_argument("--wind", type=nonneg_float, default=10.0,
+                   help="wind speed of the summary [m/s]")
     p.add_argument("--policy", default=SHIPPED_POLICY, help="policy to compare (default: shipped)")
     p.add_argument("--out", default="runs/demo")
     p.set_defaults(func=_demo_command)
@@ -102,8 +106,9 @@ def _demo_command(args) -> int:
 def _shipped(path: str) -> str:
     if Path(path).is_file():
         return path
-    raise FileNotFoundError(f"policy not found: {path} (run from the repository root, where "
-                            "agents/ holds the shipped policy, or pass --policy PATH.zip)")
+    raise FileNotFoundError(f"--policy: policy not found: {path!r} (run from the repository "
+                            "root, where agents/ holds the shipped policy, or pass --policy "
+                            "PATH.zip)")
 
 
 

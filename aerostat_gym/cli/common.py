@@ -7,13 +7,74 @@ everywhere: ``--config FILE`` (a physics parameter TOML) then ``--set SECTION.KE
 from __future__ import annotations
 
 import argparse
+import math
+import sys
+from pathlib import Path
 
 from ..params import ParameterError, load_params, tomllib
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """argparse that reports a bad option as one line on stderr (naming the option and the
+    value) and exits with status 2, instead of the usage block."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def warn(command: str, message: str) -> None:
+    """One warning line on stderr."""
+    print(f"aerostat-gym {command}: warning: {message}", file=sys.stderr)
+
+
+def _number(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}")
+    return value
+
+
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0."""
+    value = _number(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return value
+
+
+def nonneg_float(text: str) -> float:
+    """argparse type: a finite number >= 0."""
+    value = _number(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
+    return value
+
+
+def existing_file(text: str) -> str:
+    """argparse type: the path of an existing file."""
+    if not Path(text).is_file():
+        raise argparse.ArgumentTypeError(f"file not found: {text!r}")
+    return text
+
+
 def add_config(p: argparse.ArgumentParser) -> None:
     """``--config``, ``--set`` and ``--json`` on a command's parser."""
-    p.add_argument("--config", help="parameter TOML file (default: the shipped baseline)")
+    p.add_argument("--config", type=existing_file,
+                   help="parameter TOML file (default: the shipped baseline)")
     p.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override one parameter, e.g. --set tether.length=150 (repeatable)")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")

@@ -5,14 +5,17 @@ from __future__ import annotations
 
 import json
 
-from ..analysis.trim import find_equilibrium
+from ..analysis.trim import find_equilibrium, limit_warnings
 from ..bench import format_text, run_bench
 from ..params import parameter_table
-from .common import add_config, params_from_args
+from .common import add_config, nonneg_float, params_from_args, warn
 
 
 def cmd_trim(args) -> int:
-    eq = find_equilibrium(params_from_args(args), args.wind)
+    params = params_from_args(args)
+    eq = find_equilibrium(params, args.wind)
+    for message in limit_warnings(params, eq.summary):  # TrimLimitError past the tether strength
+        warn("trim", message)
     s = dict(eq.summary, relative_residual=eq.residual)
     if args.json:
         print(json.dumps(s, indent=2))
@@ -47,7 +50,8 @@ def cmd_bench(args) -> int:
 def add_model_parsers(sub) -> None:
     """Register ``trim``, ``params`` and ``bench``."""
     p = sub.add_parser("trim", help="steady equilibrium in a steady wind")
-    p.add_argument("--wind", type=float, default=10.0, help="mean wind speed [m/s] (default 10)")
+    p.add_argument("--wind", type=nonneg_float, default=10.0,
+                   help="mean wind speed [m/s] (default 10)")
     add_config(p)
     p.set_defaults(func=cmd_trim)
     p = sub.add_parser("params", help="every parameter with unit and status")

@@ -25,7 +25,8 @@ from ..analysis.figures import figure9_data, write_figure9
 from ..analysis.modes import FIGURE9_MODES, SETS, wind_sweep
 from ..analysis.reference import format_table2, table2
 from ..analysis.sensitivity import format_sensitivity, sensitivity_table
-from .common import add_config, params_from_args
+from ..analysis.trim import find_equilibrium, limit_warnings
+from .common import add_config, params_from_args, positive_float, positive_int, warn
 
 
 def parse_speeds(text: str) -> np.ndarray:
@@ -34,6 +35,8 @@ def parse_speeds(text: str) -> np.ndarray:
         parts = [float(v) for v in text.split(":")]
     except ValueError as exc:
         raise ValueError(f"--wind expects START:STOP[:STEP] or a speed, got {text!r}") from exc
+    if len(parts) > 3:
+        raise ValueError(f"--wind expects START:STOP[:STEP], got {text!r}")
     if len(parts) == 1:
         speeds = np.array(parts)
     elif len(parts) in (2, 3):
@@ -44,8 +47,8 @@ def parse_speeds(text: str) -> np.ndarray:
         speeds = np.arange(a, b + 1e-9 * max(1.0, b), step)
     else:
         raise ValueError(f"--wind expects START:STOP[:STEP], got {text!r}")
-    if np.any(speeds < 0) or not np.all(np.isfinite(speeds)):
-        raise ValueError(f"wind speeds must be finite and >= 0, got {text!r}")
+    if not np.all(np.isfinite(parts)) or np.any(speeds < 0) or speeds.size == 0:
+        raise ValueError(f"--wind: wind speeds must be finite and >= 0, got {text!r}")
     return speeds
 
 
@@ -87,6 +90,10 @@ def _stability_text(sweep, dec_ratios: list[dict]) -> str:
 def cmd_stability(args) -> int:
     params = _params(args)
     speeds = parse_speeds(args.wind)
+    # the tension grows with the wind: the top speed's trim tells what the winch and tether
+    # cannot hold (TrimLimitError past the tether strength)
+    for message in limit_warnings(params, find_equilibrium(params, float(speeds.max())).summary):
+        warn("stability", message)
     sweep = wind_sweep(params, speeds)
     ratios = [a.decoupled.ratios for a in sweep.analyses]
     if args.plot:
@@ -128,8 +135,10 @@ def add_stability_parsers(subparsers) -> None:
     """Register ``stability``, ``table2`` and ``sensitivity`` on an argparse subparsers object."""
     p = subparsers.add_parser("stability", help="linear stability against wind speed ([LN02] Fig. 9)")
     p.add_argument("--wind", default="0:20:0.5", help="START:STOP[:STEP] m/s (default 0:20:0.5)")
-    p.add_argument("--length", type=float, default=None, help="tether length [m] (default: config)")
-    p.add_argument("--elements", type=int, default=None, help="tether elements n (default: config)")
+    p.add_argument("--length", type=positive_float, default=None,
+                   help="tether length [m] (default: config)")
+    p.add_argument("--elements", type=positive_int, default=None,
+                   help="tether elements n (default: config)")
     p.add_argument("--plot", metavar="DIR", help="write figure9.png/.csv/.json into DIR")
     add_config(p)
     p.set_defaults(func=cmd_stability)

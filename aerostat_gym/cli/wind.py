@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 
 import numpy as np
@@ -16,6 +17,7 @@ from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
 from ..wind.field import build_wind, field_heights, field_times
 from ..wind.presets import METHODS, PRESETS, get_preset
 from ..wind.spectra import MODELS
+from .common import nonneg_float, positive_float, positive_int
 from ..wind.stats import (
     COMPONENTS,
     ensemble_coherence,
@@ -35,17 +37,20 @@ def add_wind_parser(subparsers) -> argparse.ArgumentParser:
         description="Generate the turbulence field of one episode and print its realised "
         "statistics (sigma, integral length scale, coherence between heights) next to their "
         "targets. One 600 s record gives rough values; pool seeds with --ensemble.")
-    p.add_argument("--preset", default="moderate", help=f"one of {list(PRESETS)}")
+    p.add_argument("--preset", default="moderate", choices=list(PRESETS))
     p.add_argument("--seed", type=int, default=0, help="seed of numpy.random.default_rng")
-    p.add_argument("--duration", type=float, default=600.0, help="episode length [s]")
-    p.add_argument("--speed", type=float, default=8.0, help="mean speed at the reference height [m/s]")
+    p.add_argument("--duration", type=positive_float, default=600.0, help="episode length [s]")
+    p.add_argument("--speed", type=nonneg_float, default=8.0,
+                   help="mean speed at the reference height [m/s]")
     p.add_argument("--profile", default="uniform", choices=sorted(PROFILES), help="mean profile")
-    p.add_argument("--reference-height", type=float, default=10.0,
+    p.add_argument("--reference-height", type=positive_float, default=10.0,
                    help="reference height of the power/log profile [m]")
     p.add_argument("--model", choices=MODELS, help="override the preset's spectrum")
     p.add_argument("--method", choices=METHODS, help="override the generation method")
-    p.add_argument("--height", type=float, help="aerostat nominal height (field advection) [m]")
-    p.add_argument("--ensemble", type=int, default=1, help="pool this many seeds from --seed on")
+    p.add_argument("--height", type=positive_float,
+                   help="aerostat nominal height (field advection) [m]")
+    p.add_argument("--ensemble", type=positive_int, default=1,
+                   help="pool this many seeds from --seed on")
     p.add_argument("--plot", metavar="FILE", help="write a PNG (time series, PSD, coherence)")
     p.add_argument("--json", action="store_true", help="print the statistics as JSON")
     p.set_defaults(func=wind_command)
@@ -77,7 +82,7 @@ def wind_command(args) -> int:
         fields = [wf] + [build_wind(mean, cfg, args.duration, np.random.default_rng(s))[1]
                          for s in range(args.seed + 1, args.seed + args.ensemble)]
     except (ValueError, TypeError) as e:
-        print(f"aerostat-gym wind: error: {e}")
+        print(f"aerostat-gym wind: error: {e}", file=sys.stderr)
         return 2
     out = {"preset": args.preset, "model": cfg.model, "method": cfg.method, "seed": args.seed,
            "duration_s": args.duration, "mean_speed": args.speed,

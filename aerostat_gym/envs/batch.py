@@ -6,9 +6,11 @@ compiled call. It owns time, the episode starts and the turbulence bank; the Gym
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
+from ..analysis.trim import TrimError
 from ..physics.integrators import scheme
 from ..physics.packing import P_SIZE
 from ..physics.state import StateLayout, work_size
@@ -17,20 +19,48 @@ from ..sim import Model
 from ..sim.events import RUNNING
 from . import kernel as K
 from . import reward, spaces
-from .config import TaskConfig
-from .episodes import (
-    DEFAULT_HORIZON,
-    TrimTable,
-    field_length_needed,
-    sample_episode,
-    turbulence_bank,
-)
+from .config import TaskConfig, TaskError
+from .episodes import TrimTable, field_length_needed, sample_episode, turbulence_bank
 
 NO_BANK = np.zeros((1, 1, 0, 3))
 
 
 class ActionError(ValueError):
-    """A non-finite or wrongly shaped action (the message names the value)."""
+    """A non-finite, non-numeric or wrongly shaped action (the message names the value)."""
+
+
+def _describe(actions) -> str:
+    text = repr(actions)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def coerce_actions(actions, n: int) -> np.ndarray:
+    """The actions of n environments as a float64 array of shape (n,).
+
+    Accepted: what Gymnasium users pass, a real number (n = 1), or a list, tuple or array of
+    real numbers of shape (n,) or (n, 1) (also (1,) and (1, 1) for n = 1). Refused with
+    :class:`ActionError` naming what was given: strings, None, booleans, complex numbers,
+    objects, and any other shape (e.g. (2, 2) or (1, 4) for n = 4).
+    """
+    if isinstance(actions, (bool, np.bool_)) or actions is None or isinstance(actions, str):
+        raise ActionError(f"action must be a real number or an array of them, got "
+                          f"{_describe(actions)}")
+    if isinstance(actions, (float, int)):
+        a = np.array([float(actions)])
+    else:
+        try:
+            a = np.asarray(actions)
+        except (TypeError, ValueError):
+            raise ActionError(f"action must be an array of real numbers, got "
+                              f"{_describe(actions)}") from None
+        if a.dtype.kind not in "fiu":
+            raise ActionError(f"action must hold real numbers (float or int), got dtype "
+                              f"{a.dtype} from {_describe(actions)}")
+    shapes = ((n,), (n, 1)) + (((), (1,), (1, 1)) if n == 1 else ())
+    if a.shape not in shapes:
+        raise ActionError(f"expected {n} action(s) of shape {(n,)} or {(n, 1)}, got shape "
+                          f"{a.shape} from {_describe(actions)}")
+    return a.astype(float).reshape(n)
 
 
 class EnvBatch:
@@ -38,11 +68,18 @@ class EnvBatch:
 
     Parameters
     ----------
-    task : TaskConfig. num_envs : number of environments.
-    horizon : longest episode [s] the turbulence must cover (None: 120 s).
+    task : TaskConfig
+        The validated environment arguments.
+    num_envs : int
+        Number of environments.
+
+    Notes
+    -----
+    The turbulence bank does not depend on the episode length: its fields are periodic and
+    read modulo their length, so every episode length is served by the same bank.
     """
 
-    def __init__(self, task: TaskConfig, num_envs: int, horizon: float | None = None):
+    def __init__(self, task: TaskConfig, num_envs: int):
         self.task = task
         self.num_envs = N = int(num_envs)
         params = task.params_resolved
@@ -52,8 +89,7 @@ class EnvBatch:
         self.full_size = S if task.observation == "full" else 0
         self.obs_dim = spaces.N_OBS + (1 + S if self.full_size else 0)
         self.obs_low, self.obs_high = spaces.bounds(self.full_size)
-        self.trims = TrimTable(params, *task.resolved["wind_speed"])
-        self.horizon = float(horizon) if horizon else DEFAULT_HORIZON
+        self.trims = trim_table(task)
         self.bank = self._bank()
         self.cfg = self._config(params)
         # per-slot arrays, one row per environment
@@ -84,8 +120,12 @@ class EnvBatch:
         if turb.is_off:
             return NO_BANK
         u_max = self.trims.speeds[-1] * _advection_factor(self.params, turb)
-        need = field_length_needed(turb, u_max, self.horizon)
+        need = field_length_needed(turb, u_max)
         return turbulence_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
+
+    def release(self) -> None:
+        """Drop this batch's reference to the turbulence bank (freed with its last user)."""
+        self.bank = NO_BANK
 
     def __getstate__(self):  # the trims and the bank are rebuilt (or found in the cache)
         d = dict(self.__dict__)
@@ -95,7 +135,7 @@ class EnvBatch:
     def __setstate__(self, d):
         self.__dict__.update(d)
         self.trims = TrimTable(self.params, *self.task.resolved["wind_speed"])
-        self.bank = self._bank()
+        self.bank = self._bank()  # found in the cache while another holder lives
 
     def _config(self, params) -> np.ndarray:
         t, w = self.task, params.winch
@@ -108,7 +148,8 @@ class EnvBatch:
         cfg[K.C_HOLD_SPEED] = w.brake_hold_speed
         cfg[K.C_SWL] = w.safe_working_load
         cfg[K.C_FULL] = 1.0 if self.full_size else 0.0
-        cfg[K.C_HORIZON] = math.inf if t.resolved["turbulence"].is_off else self.horizon
+        cfg[K.C_HORIZON] = math.inf  # the periodic field serves any episode length
+        cfg[K.C_FMAX] = w.max_motor_force
         cfg[K.C_WEIGHTS:] = t.resolved["weights"]
         return cfg
 
@@ -116,7 +157,7 @@ class EnvBatch:
 
     def reset_one(self, i: int, rng: np.random.Generator, options: dict | None = None) -> dict:
         """Start a new episode in slot i; fills obs[i] and returns the episode info."""
-        ep = sample_episode(self.task, self.trims, self.bank.shape, self.horizon, rng, options)
+        ep = sample_episode(self.task, self.trims, self.bank.shape, rng, options)
         self.state[i] = ep.x0
         self.trim_state[i] = ep.x_trim
         self.trim_tension[i] = ep.tension_trim
@@ -133,10 +174,15 @@ class EnvBatch:
         return dict(ep.info)
 
     def observe(self, i: int) -> None:
-        """Recompute obs[i] from slot i's state (no noise)."""
-        K.observe(self.state[i], self.time[i], self.packed[i], self.wind[i],
-                  self.bank[self.field_index[i]], self.work[i], self.cfg, self.trim_state[i],
-                  self.trim_tension[i], self.scale, self.low64, self.high64, self.obs[i])
+        """Recompute obs[i] (no noise) and the work array from slot i's state; a state whose
+        outputs are not finite (refused parameters should make this impossible) is an error."""
+        T_w = K.observe(self.state[i], self.time[i], self.packed[i], self.wind[i],
+                        self.bank[self.field_index[i]], self.work[i], self.cfg,
+                        self.trim_state[i], self.trim_tension[i], self.scale, self.low64,
+                        self.high64, self.obs[i])
+        if not math.isfinite(T_w):
+            raise FloatingPointError(f"environment {i}: the state gives non-finite outputs "
+                                     f"(winch tension {T_w!r})")
 
     #: Per-slot arrays that make up the simulator state of one environment.
     SLOT_ARRAYS = ("state", "trim_state", "trim_tension", "time", "action", "action_prev",
@@ -160,16 +206,15 @@ class EnvBatch:
         for name in self.SLOT_ARRAYS:
             getattr(self, name)[i] = saved[name]
         self.episodes[i] = saved["episode"]
+        obs = self.obs[i].copy()
+        self.observe(i)  # the work array: the step reads the winch tension of its start state
+        self.obs[i] = obs
 
     def set_actions(self, actions) -> np.ndarray:
-        """Validate and store actions, shape (N,) or (N, 1): NaN/inf is an ActionError,
+        """Validate and store actions (see :func:`coerce_actions`): NaN/inf is an ActionError,
         out-of-range values are clipped to [-1, 1]. Returns the per-env clipped flags (a buffer
         reused by the next call)."""
-        a = np.asarray(actions, dtype=float)
-        if a.size != self.num_envs:
-            raise ActionError(f"expected {self.num_envs} action(s) of shape (1,), got shape "
-                              f"{np.shape(actions)}")
-        a = a.reshape(self.num_envs)
+        a = coerce_actions(actions, self.num_envs)
         scalar = self.num_envs == 1  # scalar arithmetic: each numpy call costs ~1 us per step
         if not (math.isfinite(a[0]) if scalar else np.all(np.isfinite(a))):
             idx = np.flatnonzero(~np.isfinite(a))
@@ -219,6 +264,31 @@ class EnvBatch:
                 "tension": model.end_tensions(x, float(self.time[i]))[1],
                 "length": float(x[lay.winch_length]), "reel_speed": float(x[lay.winch_speed]),
                 "wind_speed": ep.wind_speed, "params": ep.params}
+
+
+def trim_table(task: TaskConfig) -> TrimTable:
+    """The task's trim table, refused (TaskError) where the configured tether cannot hold the
+    trim anywhere in the wind range, with a warning where the winch motor cannot (it then holds
+    on its brake: reel-in commands cannot be obeyed at those winds)."""
+    params = task.params_resolved
+    lo, hi = task.resolved["wind_speed"]
+    try:
+        trims = TrimTable(params, lo, hi)
+    except TrimError as exc:
+        raise TaskError(f"wind_speed {(lo, hi)}: no trim for these parameters: {exc}") from None
+    k = int(np.argmax(trims.tensions))
+    T, U = float(trims.tensions[k]), float(trims.speeds[k])
+    strength = params.tether.strength
+    if T >= strength:
+        raise TaskError(f"wind_speed up to {hi} m/s: the trim at {U} m/s loads the winch with "
+                        f"{T:.0f} N, above tether.strength = {strength:.0f} N")
+    fmax = params.winch.max_motor_force
+    if T > fmax:
+        first = float(trims.speeds[np.argmax(trims.tensions > fmax)])
+        warnings.warn(f"wind_speed up to {hi} m/s: from {first} m/s the trim tension exceeds "
+                      f"winch.max_motor_force = {fmax:.0f} N; the winch holds on its brake "
+                      "against reel-in commands there", stacklevel=3)
+    return trims
 
 
 def _advection_factor(params, turb) -> float:

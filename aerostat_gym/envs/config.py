@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..params import Params, apply_overrides, load_params
+from ..params import ParameterError, Params, apply_overrides, load_params
 from ..sim import INTEGRATORS
 from ..wind.presets import resolve_turbulence
 from . import reward
@@ -128,12 +128,26 @@ class TaskConfig:
             if not (isinstance(rel, (int, float)) and 0 <= rel < 1):
                 raise TaskError(f"randomize[{key!r}] must be a relative half-range in [0, 1), "
                                 f"got {rel!r}")
-            apply_overrides(params, {key: get_parameter(params, key)})  # names an unknown key
+            _check_range_ends(params, key, rel)
         return dict(spec)
 
     @property
     def params_resolved(self) -> Params:
         return self.resolved["params"]
+
+
+def _check_range_ends(params: Params, key: str, rel: float) -> None:
+    """Both ends of a randomisation range must load: a range whose end is infeasible (no net
+    lift, a tether length outside the winch's limits, ...) is refused when the env is made."""
+    value = get_parameter(params, key)
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        raise TaskError(f"randomize[{key!r}] must name a scalar number parameter, got {value!r}")
+    for end in (1.0 - rel, 1.0 + rel):
+        try:
+            apply_overrides(params, {key: value * end})
+        except ParameterError as exc:
+            raise TaskError(f"randomize[{key!r}] = {rel!r} reaches {key} = {value * end:.6g}, "
+                            f"which the loader refuses: {exc}") from None
 
 
 def get_parameter(params: Params, key: str):

@@ -8,7 +8,7 @@ import math
 import gymnasium as gym
 import numpy as np
 
-from ..sim.events import FIELD_END, NONFINITE, OUTCOMES, RUNNING
+from ..sim.events import FAILURES, FIELD_END, OUTCOMES, RUNNING
 from . import reward
 from .batch import EnvBatch
 from .config import TaskConfig
@@ -107,9 +107,13 @@ class TetheredAerostatEnv(gym.Env):
 
     Terminated on tether break (an element above the tether strength), ground strike (the
     aerostat CM below one hull diameter), tether length outside the winch's limits, or
-    numerical failure (``info["failure"] = "nonfinite_state"``: the observation is that of the
-    last finite state; no exception). ``info["termination"]`` names the reason. Truncated by
-    the time limit set at registration (600 steps = 120 s at the default 0.2 s control step).
+    numerical failure (``info["failure"]``: ``"nonfinite_state"``, ``"nonfinite_output"`` or
+    ``"numerical_divergence"``, a finite state beyond every physical bound, see
+    :func:`aerostat_gym.sim.events.diverged`; the observation is that of the last good state;
+    no exception). ``info["termination"]`` names the reason. Truncated by the time limit set at
+    registration (600 steps = 120 s at the default 0.2 s control step) or passed to
+    ``gym.make(..., max_episode_steps=N)``: the turbulence fields are periodic and read modulo
+    their length, so episodes of any length are served.
 
     ## Arguments
 
@@ -164,7 +168,6 @@ class TetheredAerostatEnv(gym.Env):
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        self._sync_horizon()
         info = self._batch.reset_one(0, self.np_random, options)
         self._batch.add_noise(0, self.np_random)
         if self.render_mode == "human":
@@ -191,7 +194,7 @@ class TetheredAerostatEnv(gym.Env):
             else:
                 terminated = True
                 info["termination"] = reason
-                if code == NONFINITE:
+                if code in FAILURES:
                     info["failure"] = reason
         if self.render_mode == "human":
             self.render()
@@ -214,6 +217,7 @@ class TetheredAerostatEnv(gym.Env):
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+        self._batch.release()
 
     # --- helpers ---------------------------------------------------------------------------
 
@@ -243,12 +247,6 @@ class TetheredAerostatEnv(gym.Env):
     def episode(self):
         """The current episode's start (trim, parameters, wind speed, perturbation)."""
         return self._batch.episodes[0]
-
-    def _sync_horizon(self) -> None:
-        """Size the turbulence coverage to the registered episode length once it is known."""
-        steps = getattr(self.spec, "max_episode_steps", None) if self.spec else None
-        if steps and abs(steps * self.task.control_step - self._batch.horizon) > 1e-9:
-            self._batch = EnvBatch(self.task, 1, steps * self.task.control_step)
 
     def __getstate__(self):
         d = dict(self.__dict__)

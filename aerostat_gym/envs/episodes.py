@@ -7,16 +7,17 @@ seeded the same way.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.trim import Equilibrium, find_equilibrium
-from ..params import Params, apply_overrides, dumps_toml
+from ..analysis.trim import Equilibrium, TrimError, find_equilibrium
+from ..params import ParameterError, Params, apply_overrides, dumps_toml
 from ..physics.core import euler_angles, rotation_matrix
 from ..physics.packing import pack_params
 from ..physics.state import StateLayout
-from ..physics.wind import mean_wind, set_advection, set_field, set_gust
+from ..physics.wind import mean_wind, set_advection, set_field, set_gust, set_periodic
 from ..sim import Model
 from ..wind.presets import TurbulenceConfig
 from ..wind.synthesis import fft_length, veers_field
@@ -24,7 +25,14 @@ from .config import TaskConfig, TaskError, get_parameter, perturbation
 
 WIND_GRID = 0.1  # [m/s] episode wind speeds are drawn on this grid, where the trims are exact
 FIELD_DXI = 1.0  # [m] along-wind step of the turbulence bank (0.07-0.33 s at 15-3 m/s)
-DEFAULT_HORIZON = 120.0  # [s] field coverage when the episode length is not known
+#: [s] the bank's fields are sized to serve this long a stretch at the task's top speed, twice
+#: over (random start offsets); they are periodic and read modulo their length, so episodes of
+#: any length are served and a field repeats no sooner than 2 FIELD_PERIOD_HORIZON seconds
+FIELD_PERIOD_HORIZON = 120.0
+#: the most banks kept alive by the cache at once (each is freed with its last environment)
+MAX_CACHED_BANKS = 4
+#: draws of the randomised parameters per episode start before the start is an error
+MAX_REDRAWS = 20
 
 
 # --- trims, shared between environments with the same parameters -------------------------------
@@ -62,30 +70,45 @@ def _build_trims(params: Params, speeds: np.ndarray):
 
 # --- turbulence bank ---------------------------------------------------------------------------
 
-_BANKS: dict = {}
+#: Banks in use, by (config, size, seed, length): weak references, so a bank is freed with the
+#: last environment that holds it; at most MAX_CACHED_BANKS distinct banks are findable.
+_BANKS: weakref.WeakValueDictionary = weakref.WeakValueDictionary()
 
 
 def turbulence_bank(cfg: TurbulenceConfig, size: int, seed: int, length: float) -> np.ndarray:
     """``size`` frozen turbulence fields on an along-wind grid of step FIELD_DXI [m], shape
-    (size, n_heights, n_xi, 3); cached per (config, size, seed, length).
+    (size, n_heights, n_xi, 3); shared by every environment in the process that asks for the
+    same (config, size, seed, length) while one of them holds it.
 
     The field is generated in space (Taylor's frozen turbulence): the von Karman / Dryden
     spectra and the IEC coherence depend on frequency and wind speed only through the
     wavenumber f / U, so a field synthesised at U = 1 m/s with time step FIELD_DXI is the
-    spatial field, valid for any mean speed once read with time step FIELD_DXI / U_a.
+    spatial field, valid for any mean speed once read with time step FIELD_DXI / U_a. The
+    inverse-FFT synthesis makes each field exactly periodic with its length n_xi FIELD_DXI,
+    which is why the environments read it modulo that length (a seamless wrap).
     """
     n = fft_length(length / FIELD_DXI + 1.0)
     key = (cfg, size, seed, n)
-    if key not in _BANKS:
+    bank = _BANKS.get(key)
+    if bank is None:
         rng = np.random.default_rng(seed)
         spatial = cfg.replace(dt=FIELD_DXI)
-        _BANKS[key] = np.stack([veers_field(spatial, 1.0, n, rng) for _ in range(size)])
-    return _BANKS[key]
+        bank = np.stack([veers_field(spatial, 1.0, n, rng) for _ in range(size)])
+        if len(_BANKS) >= MAX_CACHED_BANKS:  # still held by live environments: not shared
+            return bank
+        _BANKS[key] = bank
+    return bank
 
 
-def field_length_needed(cfg: TurbulenceConfig, u_max: float, horizon: float) -> float:
-    """Along-wind extent [m] a bank field needs to serve one episode at speeds up to u_max,
-    plus as much again for random start offsets."""
+def cached_bank_bytes() -> int:
+    """Bytes held by the banks the cache can still find (all of them belong to live envs)."""
+    return sum(b.nbytes for b in list(_BANKS.values()))
+
+
+def field_length_needed(cfg: TurbulenceConfig, u_max: float,
+                        horizon: float = FIELD_PERIOD_HORIZON) -> float:
+    """Along-wind extent [m] of a bank field: what one stretch of ``horizon`` seconds at speeds
+    up to u_max reads, plus as much again for random start offsets."""
     return 2.0 * (u_max * horizon + cfg.downwind_extent + cfg.upwind_extent) + 100.0
 
 
@@ -107,8 +130,8 @@ class Episode:
     info: dict
 
 
-def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, horizon: float,
-                   rng: np.random.Generator, options: dict | None = None) -> Episode:
+def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.random.Generator,
+                   options: dict | None = None) -> Episode:
     """Draw one episode start: wind speed, parameters, trim, turbulence offset, perturbation.
 
     ``options`` (from ``reset(options=...)``) may fix ``wind_speed`` (snapped to the 0.1 m/s
@@ -128,7 +151,7 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, horizon: floa
     cfg = task.resolved["turbulence"]
     wp = mean_wind(params.wind, U)
     ua = set_advection(wp, cfg.reference_height, cfg.min_advection_speed)
-    field_index, offset = _field(cfg, bank_shape, ua, horizon, wp, rng)
+    field_index, offset = _field(cfg, bank_shape, ua, wp, rng)
     x0, info = _perturb(x_trim, params, pert, wp, ua, rng)
     info.update({"wind_speed": U, "field_index": field_index, "field_offset_m": offset})
     return Episode(x0, x_trim, float(tension), pack_params(params), wp, field_index, U, params,
@@ -151,28 +174,36 @@ def _parameters(task: TaskConfig, trims: TrimTable, k: int, rng) -> tuple[Params
     if not spec:
         return trims.params, trims.states[k].copy()
     base = trims.params
-    over = {key: get_parameter(base, key) * (1.0 + rng.uniform(-rel, rel)) for key, rel in spec.items()}
-    params = apply_overrides(base, over)
-    eq = find_equilibrium(params, float(trims.speeds[k]), guess=trims.equilibrium(k),
-                          max_step=WIND_GRID)
-    return params, eq.x
+    last = None
+    for _ in range(MAX_REDRAWS):  # combinations of feasible range ends may still be infeasible
+        over = {key: get_parameter(base, key) * (1.0 + rng.uniform(-rel, rel))
+                for key, rel in spec.items()}
+        try:
+            params = apply_overrides(base, over)
+            eq = find_equilibrium(params, float(trims.speeds[k]), guess=trims.equilibrium(k),
+                                  max_step=WIND_GRID)
+            return params, eq.x
+        except (ParameterError, TrimError) as exc:
+            last = exc
+    raise TaskError(f"randomize {spec} gave no feasible aerostat in {MAX_REDRAWS} draws at "
+                    f"U = {trims.speeds[k]} m/s (last: {last}); narrow the ranges")
 
 
-def _field(cfg, bank_shape, ua, horizon, wp, rng) -> tuple[int, float]:
-    """Pick a bank field and a start offset; record its grid in wp (time step dxi / U_a)."""
+def _field(cfg, bank_shape, ua, wp, rng) -> tuple[int, float]:
+    """Pick a bank field and a start offset; record its grid in wp (time step dxi / U_a) and
+    mark it periodic: an episode longer than the field reads it round again."""
     if cfg.is_off:
         return 0, 0.0
     n_fields, nz, n_xi, _ = bank_shape
     index = int(rng.integers(n_fields))
     span = (n_xi - 1) * FIELD_DXI
     lo = cfg.downwind_extent
-    hi = span - ua * horizon - cfg.upwind_extent
-    if hi < lo:
-        raise TaskError(f"the turbulence bank ({span:.0f} m) is too short for {horizon:.0f} s at "
-                        f"U_a = {ua:.1f} m/s")
+    # offsets from which a FIELD_PERIOD_HORIZON stretch needs no wrap (any offset is valid)
+    hi = max(span - ua * FIELD_PERIOD_HORIZON - cfg.upwind_extent, lo)
     offset = float(rng.uniform(lo, hi))
     set_field(wp, cfg.z_min, cfg.dz, -offset / ua, FIELD_DXI / ua, cfg.downwind_extent,
               cfg.upwind_extent)
+    set_periodic(wp)
     return index, offset
 
 

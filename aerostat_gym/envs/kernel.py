@@ -60,7 +60,8 @@ C_HOLD_SPEED = C_DT + 3  # the brake clamps the drum below this reel speed [m/s]
 C_SWL = C_DT + 4  # safe working load [N]
 C_FULL = C_DT + 5  # 1: append the privileged full state to the observation
 C_HORIZON = C_DT + 6  # the turbulence field covers up to this time [s]
-C_WEIGHTS = C_DT + 7  # reward weights in reward.REWARD_TERMS order
+C_FMAX = C_DT + 7  # the winch motor's force limit at the line [N] (over-haul detection)
+C_WEIGHTS = C_DT + 8  # reward weights in reward.REWARD_TERMS order
 C_SIZE = C_WEIGHTS + len(R.REWARD_TERMS)
 
 _JIT = {"cache": True, "error_model": "numpy", "fastmath": FASTMATH}
@@ -74,7 +75,9 @@ def _wrap(a):
 
 @njit(**_JIT)
 def observe(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs):
-    """Fill ``obs`` (float32) for state x at time t; returns the winch tension [N].
+    """Fill ``obs`` (float32) for state x at time t; returns the winch tension [N], or NaN
+    when any output is not finite (those channels are then written as 0, so ``obs`` is always
+    finite; the caller classifies the step as a numerical failure).
 
     Channels in :data:`aerostat_gym.envs.spaces.CHANNELS` order: attitude deviations are
     theta - theta_trim etc. unchanged in sign (theta < 0 is nose up).
@@ -97,8 +100,13 @@ def observe(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs):
     raw[S.OBS_DLENGTH] = x[o + S_LENGTH] - x_trim[o + S_LENGTH]
     raw[S.OBS_REEL_SPEED] = x[o + S_REEL]
     raw[S.OBS_WIND_X], raw[S.OBS_WIND_Y], raw[S.OBS_WIND_Z] = ax, ay, az
+    finite = True
     for k in range(S.N_OBS):
-        obs[k] = min(max(raw[k] / scale[k], lo[k]), hi[k])
+        v = raw[k] / scale[k]
+        if not math.isfinite(v):
+            finite = False
+            v = 0.0
+        obs[k] = min(max(v, lo[k]), hi[k])
     if cfg[C_FULL] != 0.0:
         lim = S.FULL_STATE_LIMIT
         obs[S.OBS_FULL_WIND] = min(wp[W_UREF], lim)
@@ -106,8 +114,8 @@ def observe(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs):
             d = x[i] - x_trim[i]
             if i == o + S_PSI:
                 d = _wrap(d)
-            obs[S.OBS_FULL_STATE + i] = min(max(d, -lim), lim)
-    return T_w
+            obs[S.OBS_FULL_STATE + i] = min(max(d, -lim), lim) if math.isfinite(d) else 0.0
+    return T_w if finite else math.nan
 
 
 @njit(**_JIT)
@@ -116,12 +124,15 @@ def _step_one(x, x_prev, t, a, a_prev, braked, p, wp, wf, w, cfg, x_trim, T_trim
     """One control step of one environment; returns (outcome code, brake state, peak tension).
 
     a is the action in [-1, 1] (already clipped): set-point a * v_max through the winch's
-    brake rule. On a non-finite state the state is restored to the start of the step, so the
-    observation stays finite, and the outcome is NONFINITE.
+    brake rule, which reads the winch tension of the start state from the work array (filled
+    by the observation of that state). On a non-finite state or non-finite outputs the state
+    is restored to the start of the step, so the observation stays finite, and the outcome is
+    NONFINITE or NONFINITE_OUTPUT; a finite state beyond physical bounds is DIVERGED.
     """
     iv = aerostat_offset(int(p[P_NEL])) + S_REEL
     v_set, brake, v_w = brake_rule(a * p[P_W_VMAX], False, braked, x[iv], p[P_W_VMAX],
-                                   cfg[C_BRAKE_SPEED], cfg[C_HOLD_SPEED])
+                                   cfg[C_BRAKE_SPEED], cfg[C_HOLD_SPEED],
+                                   winch_tension(x, p, w), cfg[C_FMAX])
     x[iv] = v_w
     u = np.empty(2)
     u[0] = v_set
@@ -133,15 +144,66 @@ def _step_one(x, x_prev, t, a, a_prev, braked, p, wp, wf, w, cfg, x_trim, T_trim
     status = advance_interval(x, t, cfg[C_DT], u, p, wp, wf, w, cfg, stats)
     t1 = t + cfg[C_DT]
     if status == NONFINITE:
-        x[:] = x_prev
-        observe(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)
-        terms[:] = 0.0
-        terms[R.R_TERMINATION] = -cfg[C_WEIGHTS + R.R_TERMINATION]  # the termination term only
-        return E.NONFINITE, brake, 0.0
-    observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)
+        return _failed(E.NONFINITE, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo,
+                       hi, obs, terms), brake, 0.0
+    if not math.isfinite(observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)):
+        return _failed(E.NONFINITE_OUTPUT, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim,
+                       scale, lo, hi, obs, terms), brake, 0.0
     code = E.step_outcome(x, t1, p, stats[0], cfg[C_GROUND], cfg[C_HORIZON])
+    if code == E.TETHER_BREAK or code == E.GROUND_STRIKE or code == E.LENGTH_LIMIT:
+        if not _confirmed(x, stats[0], x_prev, t, u, p, wp, wf, w, cfg):
+            code = E.DIVERGED
+        observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)  # refill w
+    if code == E.DIVERGED:
+        return _failed(code, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi,
+                       obs, terms), brake, 0.0
     R.reward_terms(obs, a, a_prev, stats[0], code, cfg[C_WEIGHTS:], cfg[C_SWL], terms)
     return code, brake, stats[0]
+
+
+#: [-] a terminating step is physical when half the integration step reproduces its end state
+#: to this fraction of the state's largest entry (integration error is far smaller; an
+#: integrator past its stability step misses by orders of magnitude)
+REPRODUCE_TOL = 1e-3
+
+
+@njit(**_JIT)
+def _confirmed(x, peak, x_prev, t, u, p, wp, wf, w, cfg):
+    """Re-run the control step from x_prev with half the integration step: a physical event
+    (tether break, ground strike, length limit) is reproduced, the end state to REPRODUCE_TOL
+    and the peak tension within a factor of 2; an integrator past its stability step is not
+    (it is stable at half the step, or blows up differently). Runs only on a terminating step.
+    """
+    half = cfg.copy()
+    half[C_RK4_SAFETY] *= 0.5
+    half[C_SI_DT] *= 0.5
+    half[C_STEP] *= 0.5
+    x2 = x_prev.copy()
+    stats = np.empty(2)
+    stats[0] = 0.0
+    stats[1] = np.inf
+    if advance_interval(x2, t, cfg[C_DT], u, p, wp, wf, w, half, stats) == NONFINITE:
+        return False
+    if not 0.5 * peak <= stats[0] <= 2.0 * peak:
+        return False
+    big = 1.0
+    for i in range(x.size):
+        big = max(big, abs(x[i]))
+    for i in range(x.size):
+        if not abs(x2[i] - x[i]) <= REPRODUCE_TOL * big:
+            return False
+    return True
+
+
+@njit(**_JIT)
+def _failed(code, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs, terms):
+    """A numerical failure: restore the start-of-step state and its (finite) observation,
+    keep only the termination reward term; returns the outcome code."""
+    x[:] = x_prev
+    observe(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)
+    terms[:] = 0.0
+    terms[R.R_TERMINATION] = -cfg[C_WEIGHTS + R.R_TERMINATION]
+    return code
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, parallel=True)

@@ -19,7 +19,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from ..sim.events import FIELD_END, NONFINITE, OUTCOMES, RUNNING
+from ..sim.events import FAILURES, FIELD_END, OUTCOMES, RUNNING
 from . import reward
 from .batch import EnvBatch
 from .config import TaskConfig
@@ -52,7 +52,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
         self.task = TaskConfig(**kwargs)
         self.max_episode_steps = int(max_episode_steps or DEFAULT_MAX_EPISODE_STEPS)
         self.num_envs = num_envs
-        self.batch = EnvBatch(self.task, num_envs, self.max_episode_steps * self.task.control_step)
+        self.batch = EnvBatch(self.task, num_envs)
         b = self.batch
         self.single_action_space = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
         self.single_observation_space = gym.spaces.Box(b.obs_low, b.obs_high, dtype=np.float32)
@@ -102,8 +102,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
         if self.autoreset_mode == AutoresetMode.NEXT_STEP:
             self._pending = done.copy()
         elif done.any():
-            info["final_obs"] = np.array([b.obs[i].copy() if d else None
-                                          for i, d in enumerate(done)], dtype=object)
+            info["final_obs"] = _final_obs(b.obs, done)
             info["_final_obs"] = done.copy()
             resets = [(i, self._reset(i, {})) for i in np.flatnonzero(done)]
             info.update(_stack_infos(resets, self.num_envs, prefix="reset_"))
@@ -121,6 +120,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
     def close_extras(self, **kwargs):
         if self._renderer is not None:
             self._renderer.close()
+        self.batch.release()
 
     # --- helpers ---------------------------------------------------------------------------
 
@@ -151,7 +151,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
                 code = int(b.code[i])
                 reason = OUTCOMES.get(code, "time_limit")
                 _put(info, name, i, reason, self.num_envs)
-                if code == NONFINITE:
+                if code in FAILURES:
                     _put(info, "failure", i, reason, self.num_envs)
         return info
 
@@ -168,6 +168,16 @@ class TetheredAerostatVectorEnv(VectorEnv):
         d = dict(self.__dict__)
         d["_renderer"] = None
         return d
+
+
+def _final_obs(obs: np.ndarray, done: np.ndarray) -> np.ndarray:
+    """Gymnasium's same-step ``final_obs``: a 1-D object array holding each ended slot's
+    float32 observation (None elsewhere). Built element by element: ``np.array`` of a list of
+    equal-shape arrays would make a 2-D object array of scalars instead."""
+    out = np.full(obs.shape[0], None, dtype=object)
+    for i in np.flatnonzero(done):
+        out[i] = obs[i].copy()
+    return out
 
 
 def _seeds(seed, n):

@@ -611,6 +611,13 @@ def _winch(x, u, p, Tw, dx, o):
     The square-root part decelerates at a_max / 2, leaving the other half to the lag; the linear
     part makes the closed loop critically damped at the limit (tau d'' + d' + d / (4 tau) = 0),
     so the drum stops at the limit without overshoot when the motor has authority.
+
+    Over-hauled (the motor force saturated), the drum speed never exceeds its rating v_max:
+    the overspeed brake takes whatever the motor cannot, so that |v_w'| <= (v_max -+ v_w) / tau,
+    the bound the unsaturated speed loop obeys anyway (v_s is within +-v_max); the drum then
+    approaches v_max with the loop's time constant and a drum found beyond it returns to it. The holding brake that stops an
+    over-hauled drum against a reel-in or hold command is supervisory
+    (:func:`aerostat_gym.sim.winch.brake_rule`): it arrives here as u[1] != 0.
     """
     L, v = x[o + S_LENGTH], x[o + S_REEL]
     if u[1] != 0.0:
@@ -627,8 +634,13 @@ def _winch(x, u, p, Tw, dx, o):
     m_eq = p[P_W_MEQ]
     fr = winch_friction(v, p)
     Fm = min(max(m_eq * a_des - Tw + fr, -p[P_W_FMAX]), p[P_W_FMAX])
+    dv = (Tw + Fm - fr) / m_eq
+    if abs(Fm) >= p[P_W_FMAX]:
+        # motor saturated: the overspeed brake takes what the motor cannot, so the drum
+        # approaches its rated speed no faster than the speed loop would (never beyond it)
+        dv = min(max(dv, (-vmax - v) / tau), (vmax - v) / tau)
     dx[o + S_LENGTH] = v
-    dx[o + S_REEL] = (Tw + Fm - fr) / m_eq
+    dx[o + S_REEL] = dv
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")

@@ -63,6 +63,9 @@ W_FIELD_XUP = 21  # ... and up to this far upwind of the anchor [m]
 W_FIELD_IDZ = 22
 W_FIELD_IDT = 23
 W_TAYLOR_IDX = 24
+# 1: the field is periodic in time with its own length (an inverse-FFT synthesis is), and is
+# read modulo that length, so an episode of any length is served; 0: edge values are held
+W_FIELD_PERIODIC = 25
 W_SIZE = 32
 
 PROFILES = {"uniform": 0, "power": 1, "log": 2}
@@ -173,6 +176,12 @@ def set_field(wp: np.ndarray, z0: float, dz: float, t0: float, dt: float,
     _update_derived(wp)
 
 
+def set_periodic(wp: np.ndarray, periodic: bool = True) -> None:
+    """Read the field modulo its length (in place): for fields synthesised by an inverse FFT,
+    which are exactly periodic, so the wrap is seamless (sample n equals sample 0)."""
+    wp[W_FIELD_PERIODIC] = 1.0 if periodic else 0.0
+
+
 NO_FIELD = np.zeros((1, 0, 3))
 
 # Compilation flags of the wind kernels. They only read arrays they are given, so they need no
@@ -213,22 +222,40 @@ def _grid_index(f, n):
 
 
 @njit(**_JIT, inline="always")
+def _periodic_index(f, n):
+    """Lower index, weight and upper index of fractional position f on a periodic grid of n
+    points (f taken modulo n; a NaN or infinite position reads the first point)."""
+    if not abs(f) < 1e300:
+        f = 0.0
+    f = f - n * math.floor(f / n)
+    k = min(int(f), n - 1)
+    k1 = k + 1 if k + 1 < n else 0
+    return k, f - k, k1
+
+
+@njit(**_JIT, inline="always")
 def _field_sample(xa, z, t, wp, wf):
     """Bilinear interpolation of the field at height z and Taylor-delayed time t - xa / U_a.
 
-    Outside the grids the nearest edge value is held (heights above the top row read the top
-    row); :func:`aerostat_gym.wind.check_covers` verifies that an episode stays inside in time.
+    Outside the height grid the nearest edge value is held (heights above the top row read the
+    top row). In time, a periodic field (``W_FIELD_PERIODIC``) is read modulo its length;
+    otherwise the edge is held and :func:`aerostat_gym.wind.check_covers` verifies that a run
+    stays inside.
     """
     nz, nt = wf.shape[0], wf.shape[1]
     kz, az = _grid_index((z - wp[W_FIELD_Z0]) * wp[W_FIELD_IDZ], nz)
     # field time index of t - xa / U_a: ((t - t0) / dt) - xa / (U_a dt)
-    kt, at = _grid_index((t - wp[W_FIELD_T0]) * wp[W_FIELD_IDT] - xa * wp[W_TAYLOR_IDX], nt)
+    ft = (t - wp[W_FIELD_T0]) * wp[W_FIELD_IDT] - xa * wp[W_TAYLOR_IDX]
+    if wp[W_FIELD_PERIODIC] != 0.0:
+        kt, at, kt1 = _periodic_index(ft, nt)
+    else:
+        kt, at = _grid_index(ft, nt)
+        kt1 = kt + 1
     kz1 = kz + 1 if nz > 1 else kz
     w00 = (1.0 - az) * (1.0 - at)
     w01 = (1.0 - az) * at
     w10 = az * (1.0 - at)
     w11 = az * at
-    kt1 = kt + 1
     return (w00 * wf[kz, kt, 0] + w01 * wf[kz, kt1, 0] + w10 * wf[kz1, kt, 0] + w11 * wf[kz1, kt1, 0],
             w00 * wf[kz, kt, 1] + w01 * wf[kz, kt1, 1] + w10 * wf[kz1, kt, 1] + w11 * wf[kz1, kt1, 1],
             w00 * wf[kz, kt, 2] + w01 * wf[kz, kt1, 2] + w10 * wf[kz1, kt, 2] + w11 * wf[kz1, kt1, 2])

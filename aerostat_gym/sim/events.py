@@ -10,17 +10,33 @@ from __future__ import annotations
 from numba import njit
 
 from ..physics.core import FASTMATH
-from ..physics.packing import P_NEL, P_STRENGTH, P_W_LMAX, P_W_LMIN
-from ..physics.state import S_LENGTH, S_Z, aerostat_offset
+from ..physics.packing import P_ANCHOR, P_NEL, P_STRENGTH, P_W_LMAX, P_W_LMIN, P_W_VMAX
+from ..physics.state import S_LENGTH, S_P, S_REEL, S_VX, S_X, S_Z, aerostat_offset
 
-#: Outcome codes of a control step.
-RUNNING, NONFINITE, TETHER_BREAK, GROUND_STRIKE, LENGTH_LIMIT, FIELD_END = range(6)
+#: Outcome codes of a control step. DIVERGED and NONFINITE_OUTPUT are numerical failures, like
+#: NONFINITE: the integration, not the physics, has gone wrong.
+(RUNNING, NONFINITE, TETHER_BREAK, GROUND_STRIKE, LENGTH_LIMIT, FIELD_END, DIVERGED,
+ NONFINITE_OUTPUT) = range(8)
 #: Reason strings (``info["termination"]``, ``info["failure"]``, ``info["truncation"]``).
 OUTCOMES = {NONFINITE: "nonfinite_state", TETHER_BREAK: "tether_break",
             GROUND_STRIKE: "ground_strike", LENGTH_LIMIT: "length_limit",
-            FIELD_END: "wind_field_exhausted"}
+            FIELD_END: "wind_field_exhausted", DIVERGED: "numerical_divergence",
+            NONFINITE_OUTPUT: "nonfinite_output"}
+#: The codes that are numerical failures (reported in ``info["failure"]`` too).
+FAILURES = (NONFINITE, DIVERGED, NONFINITE_OUTPUT)
 #: [m] the winch's stopping profile keeps L inside its limits to much better than this.
 LENGTH_TOL = 1e-3
+#: Bounds past which a finite state is a numerical divergence, not a physical event. Nothing in
+#: a tethered aerostat moves at 1 km/s (three times the speed of sound, where the model's
+#: incompressible aerodynamics means nothing), spins at 100 rad/s, strays ten line lengths from
+#: its winch or loads its tether to 100 times the breaking strength: an explicit integrator past
+#: its stability step reaches these within one control step (the RK4 amplification at 1.2 times
+#: the bound is above 3 per substep), a physical break or ground strike never does.
+SPEED_DIVERGED = 1.0e3  # [m/s] node or CM speed component
+RATE_DIVERGED = 100.0  # [rad/s] body rate
+REACH_DIVERGED = 10.0  # [-] distance from the anchor / longest line length
+TENSION_DIVERGED = 100.0  # [-] peak element tension / tether strength
+REEL_DIVERGED = 2.0  # [-] reel speed / rated drum speed (the overspeed brake holds it to 1)
 
 _JIT = {"cache": True, "error_model": "numpy", "fastmath": FASTMATH}
 
@@ -32,15 +48,41 @@ def tether_broken(peak_tension, strength):
 
 
 @njit(**_JIT)
+def diverged(x, p, peak_tension):
+    """True when a finite state is beyond every physical bound (the ``*_DIVERGED`` constants):
+    the integration has blown up."""
+    n = int(p[P_NEL])
+    o = aerostat_offset(n)
+    if not peak_tension <= TENSION_DIVERGED * p[P_STRENGTH]:
+        return True
+    reach = REACH_DIVERGED * p[P_W_LMAX]
+    for j in range(n - 1):  # moving tether nodes: positions then velocities
+        for k in range(3):
+            if not abs(x[3 * j + k] - p[P_ANCHOR + k]) <= reach:
+                return True
+            if not abs(x[3 * (n - 1) + 3 * j + k]) <= SPEED_DIVERGED:
+                return True
+    for k in range(3):
+        if not abs(x[o + S_X + k] - p[P_ANCHOR + k]) <= reach or not abs(x[o + S_VX + k]) <= SPEED_DIVERGED:
+            return True
+        if not abs(x[o + S_P + k]) <= RATE_DIVERGED:
+            return True
+    return not abs(x[o + S_REEL]) <= REEL_DIVERGED * p[P_W_VMAX]
+
+
+@njit(**_JIT)
 def step_outcome(x, t, p, peak_tension, ground_height, horizon):
     """Outcome code at the end of a control step ending at time t.
 
     peak_tension : largest element tension over the step [N]. ground_height : CM height below
     which the aerostat has struck the ground [m]. horizon : last time the turbulence field
-    covers [s] (inf without turbulence). Checked in this order: break, ground strike, length
-    outside the winch's limits, end of the wind field.
+    covers [s] (inf for the environments' periodic fields). Checked in this order: numerical
+    divergence (:func:`diverged`), break, ground strike, length outside the winch's limits,
+    end of the wind field.
     """
     o = aerostat_offset(int(p[P_NEL]))
+    if diverged(x, p, peak_tension):
+        return DIVERGED
     if tether_broken(peak_tension, p[P_STRENGTH]):
         return TETHER_BREAK
     if x[o + S_Z] < ground_height:

@@ -113,7 +113,7 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
     status, events, cmds = "ok", [], []
     for k in range(n_out):
         t = k * output_dt
-        cmd = winch.command(_input(u, t, x), x)
+        cmd = winch.command(_input(u, t, x), x, winch.load_cell(ends[-1][1]))
         st, stats = model.advance(x, t, output_dt, cmd.as_input(), integrator, dt)
         if st == NONFINITE:
             status = "nonfinite"

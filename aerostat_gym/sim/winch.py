@@ -105,14 +105,50 @@ def parse_command(u) -> tuple[float, bool]:
 
 
 @njit(cache=True)
-def brake_rule(v, brake_cmd, braked, v_w, max_speed, brake_speed, hold_speed):
+def brake_rule(v, brake_cmd, braked, v_w, max_speed, brake_speed, hold_speed,
+               tension=0.0, max_force=np.inf):
     """One control step of the winch's supervisory logic; returns (v_set, brake, v_w).
 
+    Parameters
+    ----------
+    v : float
+        Requested reel-out speed [m/s].
+    brake_cmd : bool
+        The brake is commanded.
+    braked : bool
+        The brake held the drum over the last step.
+    v_w : float
+        Drum (reel-out) speed at the start of the step [m/s].
+    max_speed : float
+        Rated drum speed [m/s].
+    brake_speed : float
+        Set-points below this engage the brake [m/s].
+    hold_speed : float
+        The brake clamps the drum once it is this slow [m/s].
+    tension : float
+        Load-cell tension at the start of the step [N].
+    max_force : float
+        The motor's force limit at the line [N].
+
+    Notes
+    -----
     The brake is wanted when commanded or when |v| < brake_speed. It clamps the drum (v_w set to
     exactly 0) if it already held it or once |v_w| <= hold_speed; until then the speed loop
     decelerates the drum with set-point 0. Released, the set-point is clipped to +-max_speed.
+
+    Over-hauled (the line tension above the motor's force limit, so the motor cannot hold the
+    load), a ground winch does not let the load run the drum out against a reel-in or hold
+    command: its holding brake sets at once, whatever the drum speed, and stays set while the
+    load exceeds the motor force (the drive releases the brake only onto a load it can hold).
+    The brake's holding rating is taken at or above the tether strength, so it holds until
+    the tether breaks. A pay-out command is obeyed, at no more than the rated drum speed (the
+    overspeed brake in :func:`aerostat_gym.physics.core._winch`). A drum speed above the rating
+    (a step that ended over-hauled) is brought back to it here.
     Compiled so the environment's compiled step applies the same rule.
     """
+    v_w = min(max(v_w, -max_speed), max_speed)
+    if tension > max_force and (brake_cmd or v < brake_speed):
+        return 0.0, True, 0.0
     if brake_cmd or abs(v) < brake_speed:
         if braked or abs(v_w) <= hold_speed:
             return 0.0, True, 0.0
@@ -137,9 +173,6 @@ class WinchController:
     def __init__(self, params: Params | None = None):
         self.params = params or load_params()
         w = self.params.winch
-        if w.total_line_length < w.max_length:
-            raise ValueError(f"winch.total_line_length ({w.total_line_length} m) must be >= "
-                             f"winch.max_length ({w.max_length} m): the drum cannot pay out more line than it holds")
         self.layout = StateLayout(self.params.tether.n_elements)
         self.mu = self.params.derived.mass_per_length
         self.thresholds = WinchThresholds.from_params(self.params)
@@ -154,8 +187,9 @@ class WinchController:
 
     # --- command -------------------------------------------------------------------------------
 
-    def command(self, u, x: np.ndarray) -> WinchCommand:
-        """Validate and apply one command ``u`` (v_set or [v_set, brake]) at state ``x``.
+    def command(self, u, x: np.ndarray, tension: float = 0.0) -> WinchCommand:
+        """Validate and apply one command ``u`` (v_set or [v_set, brake]) at state ``x``, with
+        the load-cell ``tension`` [N] of that state (over-haul hold, see :func:`brake_rule`).
 
         Brake rule: wanted when commanded or when |v_set| < brake_speed. If the drum is slow
         enough (|v_w| <= brake_hold_speed) the brake clamps: ``x[v_w]`` is set to exactly 0 (in
@@ -170,7 +204,8 @@ class WinchController:
         self.n_clipped += int(clipped)
         iv = self.layout.winch_speed
         v_set, brake, v_w = brake_rule(v, brake_cmd, self.braked, x[iv], w.max_speed,
-                                       w.brake_speed, w.brake_hold_speed)
+                                       w.brake_speed, w.brake_hold_speed, float(tension),
+                                       w.max_motor_force)
         clamped = brake and not self.braked
         x[iv] = v_w  # exactly 0 once the brake holds the drum
         self.braked = brake

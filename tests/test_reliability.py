@@ -1,0 +1,500 @@
+"""Issue 14: every promise of the environment holds off the default path, and every bad input
+is refused at the door. One test (or a few) per defect of the issue, numbered as there, then
+the soak smoke run and the memory check.
+
+Each test asserts a value against a reference (a closed form, a rated limit, the loader's
+contract of naming the field) with its tolerance.
+"""
+
+from __future__ import annotations
+
+import gc
+import math
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import aerostat_gym  # noqa: F401  (registers the environment)
+from aerostat_gym.analysis import trim as trim_module
+from aerostat_gym.analysis.trim import find_equilibrium
+from aerostat_gym.cli import main as cli_main
+from aerostat_gym.envs import ActionError, TaskError, TetheredAerostatEnv
+from aerostat_gym.envs import episodes
+from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
+from aerostat_gym.params import MAX_ELEMENTS, ParameterError, load_params
+from aerostat_gym.physics.wind import NO_FIELD, W_FIELD_T0, air_velocity, pack_wind, set_field
+from aerostat_gym.physics.wind import set_periodic
+from aerostat_gym.sim import Model
+
+ENV_ID = "TetheredAerostat-v0"
+QUIET = {"turbulence": "none", "perturbation": "none"}
+
+
+def _quiet(fn, *args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fn(*args, **kwargs)
+
+
+# --- 1. turbulent episodes of any length ---------------------------------------------------------
+
+
+def test_1_turbulent_episode_runs_past_120_s_to_the_requested_limit():
+    """400 steps of 1 s in moderate turbulence: truncated by the time limit at 400 s, never
+    by the turbulence field (on the unfixed code: 'wind_field_exhausted' at 121 s)."""
+    env = gym.make(ENV_ID, max_episode_steps=400, control_step=1.0, n_elements=5,
+                   wind_speed=(15.0, 15.0), turbulence="moderate", perturbation="none")
+    env.reset(seed=3)
+    for k in range(400):
+        obs, _, terminated, truncated, info = env.step(np.zeros(1, np.float32))
+        assert np.all(np.isfinite(obs))
+        if terminated or truncated:
+            break
+    assert k == 399 and truncated and not terminated
+    assert "truncation" not in info  # the TimeLimit wrapper's truncation, no field end
+    assert info["time"] == pytest.approx(400.0, abs=1e-6)
+
+
+def test_1_periodic_field_wraps_seamlessly():
+    """A periodic field read at fractional index n - 1/2 gives the mean of its last and first
+    samples, and at t + period the same value as at t (closed forms of the wrap)."""
+    rng = np.random.default_rng(0)
+    n = 16
+    wf = rng.normal(size=(1, n, 3))
+    wp = pack_wind("uniform", 10.0)
+    set_field(wp, 0.0, 10.0, 0.0, 0.5, 50.0, 50.0)
+    set_periodic(wp)
+    t_half = (n - 0.5) * 0.5  # between sample n - 1 and sample n = sample 0
+    got = np.array(air_velocity(0.0, 0.0, 0.0, t_half, wp, wf))
+    want = np.array([10.0, 0.0, 0.0]) + 0.5 * (wf[0, -1] + wf[0, 0])
+    assert np.allclose(got, want, rtol=0, atol=1e-12)
+    t = 1.37
+    a = np.array(air_velocity(0.0, 0.0, 0.0, t, wp, wf))
+    b = np.array(air_velocity(0.0, 0.0, 0.0, t + 3 * n * 0.5, wp, wf))
+    assert np.allclose(a, b, rtol=0, atol=1e-12)
+    assert wp[W_FIELD_T0] == 0.0
+
+
+def test_1_single_env_equals_vector_slot_across_an_autoreset():
+    """gym.make with max_episode_steps = 30 and the vector env with the same limit: slot 0
+    seeded like the single env reproduces it bit for bit through the autoreset."""
+    kw = {"control_step": 0.5, "n_elements": 5, "wind_speed": (8.0, 12.0),
+          "turbulence": "moderate"}
+    single = gym.make(ENV_ID, max_episode_steps=30, **kw)
+    vec = TetheredAerostatVectorEnv(2, max_episode_steps=30, **kw)
+    obs_s, _ = single.reset(seed=11)
+    obs_v, _ = vec.reset(seed=11)
+    assert np.array_equal(obs_s, obs_v[0])
+    actions = np.random.default_rng(1).uniform(-1, 1, (45, 1)).astype(np.float32)
+    for k, a in enumerate(actions):
+        obs_v, *_ = vec.step(np.array([a, a]))
+        if k == 30:  # NEXT_STEP: the vector slot starts its next episode on this step
+            obs_s, _ = single.reset()
+        else:
+            obs_s, _, term, trunc, _ = single.step(a)
+            assert (term or trunc) == (k == 29)
+        assert np.array_equal(obs_s, obs_v[0]), f"step {k}"
+
+
+# --- 2. final_obs dtype ---------------------------------------------------------------------------
+
+
+def test_2_final_obs_is_float32_when_every_slot_ends_together():
+    env = TetheredAerostatVectorEnv(3, max_episode_steps=1, autoreset_mode="SameStep",
+                                    n_elements=5, **QUIET)
+    env.reset(seed=0)
+    _, _, _, truncated, info = env.step(np.zeros((3, 1)))
+    assert truncated.all()
+    fo = info["final_obs"]
+    assert fo.shape == (3,)
+    for i in range(3):
+        assert fo[i].dtype == np.float32 and fo[i].shape == env.single_observation_space.shape
+
+
+def test_2_sb3_terminal_observation_is_float32():
+    pytest.importorskip("stable_baselines3")
+    from aerostat_gym.envs.sb3 import sb3_vec_env
+
+    venv = sb3_vec_env(2, seed=0, max_episode_steps=1, n_elements=5, **QUIET)
+    venv.reset()
+    _, _, dones, infos = venv.step(np.zeros((2, 1), np.float32))
+    assert dones.all()
+    for info in infos:
+        term = info["terminal_observation"]
+        assert term.dtype == np.float32 and term.shape == (19,)
+
+
+# --- 3. winch over-hauled ------------------------------------------------------------------------
+
+
+def _high_wind_env(**kw):
+    return _quiet(TetheredAerostatEnv, wind_speed=(32.0, 32.0), n_elements=5, **QUIET, **kw)
+
+
+def test_3_overhauled_winch_holds_against_reel_in():
+    """At 32 m/s the trim tension (about 11.6 kN) is above the 8 kN motor limit: full reel-in
+    commands leave the line length where it was (the holding brake) instead of paying out."""
+    env = _high_wind_env()
+    env.reset(seed=0)
+    lay = env._batch.layout
+    L0 = env.state[lay.winch_length]
+    for _ in range(150):  # 30 s
+        _, _, terminated, truncated, info = env.step(np.array([-1.0], np.float32))
+        assert not terminated, info
+    s = env.state
+    assert abs(s[lay.winch_length] - L0) < 1e-9
+    assert s[lay.winch_speed] == 0.0
+
+
+def test_3_overhauled_drum_never_exceeds_its_rated_speed():
+    """Paying out over-hauled, the drum runs at its rated speed 1 m/s and never above it; the
+    line paid out over 30 s is 1 m/s x 30 s less the speed-loop lag (tau = 0.3 s)."""
+    env = _high_wind_env()
+    env.reset(seed=0)
+    lay = env._batch.layout
+    vmax = env._batch.params.winch.max_speed
+    L0 = env.state[lay.winch_length]
+    speeds = []
+    for _ in range(150):
+        env.step(np.array([1.0], np.float32))
+        speeds.append(env.state[lay.winch_speed])
+    assert max(speeds) <= vmax * (1 + 1e-12)
+    assert speeds[-1] == pytest.approx(vmax, rel=1e-3)
+    paid = env.state[lay.winch_length] - L0
+    assert paid == pytest.approx(vmax * 30.0, abs=vmax * 2.5)  # lag: <= tau + v/a_max = 2.3 s
+
+
+def test_3_brake_rule_overhaul_closed_form():
+    from aerostat_gym.sim.winch import brake_rule
+
+    # over-hauled, reel-in: brake sets at once, even at speed
+    assert brake_rule(-1.0, False, False, 0.8, 1.0, 0.02, 0.02, 9000.0, 8000.0) == (0.0, True, 0.0)
+    # over-hauled, pay-out: obeyed (the drum speed is capped at the rating)
+    assert brake_rule(0.5, False, False, 1.7, 1.0, 0.02, 0.02, 9000.0, 8000.0) == (0.5, False, 1.0)
+    # within the motor's force: the old rule (reel-in released)
+    assert brake_rule(-1.0, False, True, 0.0, 1.0, 0.02, 0.02, 7000.0, 8000.0) == (-1.0, False, 0.0)
+
+
+# --- 4. feasibility across sections ---------------------------------------------------------------
+
+
+@pytest.mark.parametrize("override, names", [
+    ({"tether.length": 100.0}, ("tether.length", "winch.min_length", "100.0", "150.0")),
+    ({"winch.total_line_length": 300.0}, ("winch.total_line_length", "winch.max_length", "300.0")),
+    ({"tether.density": 40000.0}, ("tether.length", "tether.density", "aerostat.volume")),
+    ({"tether.strength": 2000.0}, ("tether.strength", "aerostat.volume", "2000.0")),
+    ({"winch.safe_working_load": 5e4}, ("winch.safe_working_load", "tether.strength")),
+])
+def test_4_infeasible_combinations_are_refused_at_load(override, names):
+    with pytest.raises(ParameterError) as err:
+        load_params(overrides=override)
+    for name in names:
+        assert name in str(err.value)
+
+
+def test_4_tether_strength_below_trim_tension_in_the_wind_range():
+    """strength 3.5 kN: above the 2.6 kN still-air tension (loads), below the 3.79 kN trim at
+    15 m/s: the env refuses the wind range, naming both."""
+    p = load_params(overrides={"tether.strength": 3500.0, "winch.safe_working_load": 1000.0})
+    with pytest.raises(TaskError) as err:
+        TetheredAerostatEnv(params=p, wind_speed=(3.0, 15.0), n_elements=5, **QUIET)
+    assert "wind_speed" in str(err.value) and "tether.strength" in str(err.value)
+
+
+# --- 5. coefficient lists -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("key, value", [
+    ("tether.loading_fn", [0.5, math.nan, 0.1, -0.4, -0.011]),
+    ("tether.loading_ft", [0.02, -0.0039, 0.019, math.inf, 0.035, -0.012]),
+    ("tether.loading_fn", [0.5, -0.1, 0.1, -0.4]),
+    ("tether.loading_ft", [0.02] * 7),
+])
+def test_5_coefficient_lists_checked_for_finiteness_and_length(key, value):
+    with pytest.raises(ParameterError, match=key.replace(".", r"\.")):
+        load_params(overrides={key: value})
+
+
+# --- 6. no NaN observation; divergence is numerical --------------------------------------------------
+
+
+def test_6_huge_finite_state_is_a_numerical_failure_with_a_finite_observation():
+    """A state at 3e27 m (what a 1e30 m^3 volume's trim gave) is classified as a numerical
+    divergence, not a tether break, and the observation stays finite."""
+    env = TetheredAerostatEnv(n_elements=5, **QUIET)
+    env.reset(seed=0)
+    saved = env.get_state()
+    lay = env._batch.layout
+    saved["state"] = saved["state"].copy()
+    saved["state"][lay.cm_pos] += np.array([0.0, 0.0, 3e27])
+    env.set_state(saved)
+    obs, reward, terminated, _, info = env.step(np.zeros(1, np.float32))
+    assert terminated and info["failure"] in ("numerical_divergence", "nonfinite_output")
+    assert info["termination"] == info["failure"]
+    assert np.all(np.isfinite(obs)) and math.isfinite(reward)
+
+
+def test_6_huge_volume_is_refused_at_load():
+    with pytest.raises(ParameterError, match="aerostat.volume"):
+        load_params(overrides={"aerostat.volume": 1e30})
+
+
+def test_6_nonfinite_output_is_reported_and_observation_finite():
+    """The observation kernel returns NaN (and writes finite channels) when an output is not
+    finite: here a NaN wind speed in the packed wind vector."""
+    from aerostat_gym.envs import kernel as K
+
+    env = TetheredAerostatEnv(n_elements=5, **QUIET)
+    env.reset(seed=0)
+    b = env._batch
+    wp = b.wind[0].copy()
+    wp[1] = math.nan  # W_UREF
+    obs = np.zeros_like(b.obs[0])
+    T = K.observe(b.state[0], 0.0, b.packed[0], wp, NO_FIELD, b.work[0].copy(), b.cfg,
+                  b.trim_state[0], b.trim_tension[0], b.scale, b.low64, b.high64, obs)
+    assert math.isnan(T)
+    assert np.all(np.isfinite(obs))
+
+
+def test_6_rk4_past_its_stability_step_is_a_numerical_failure():
+    """RK4 at 1.4 times its stability bound blows up; the episode ends as a numerical
+    failure, never as a tether break or a length-limit excursion."""
+    env = _quiet(TetheredAerostatEnv, integrator="rk4", overrides={"simulation.rk4_safety": 1.4},
+                 wind_speed=(10.0, 10.0), n_elements=5, turbulence="none",
+                 perturbation="displacement")
+    env.reset(seed=0)
+    for _ in range(50):
+        obs, _, terminated, _, info = env.step(np.array([0.5], np.float32))
+        assert np.all(np.isfinite(obs))
+        if terminated:
+            break
+    assert terminated
+    assert info["termination"] in ("numerical_divergence", "nonfinite_state")
+    assert info["failure"] == info["termination"]
+
+
+# --- 7. out-of-range winds ---------------------------------------------------------------------
+
+
+def _cli(capsys, *argv):
+    try:
+        code = cli_main(list(argv))
+    except SystemExit as exc:
+        code = exc.code
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_7_trim_past_the_tether_strength_is_refused(capsys):
+    """At 100 m/s the trim tension is about 111 kN, three times the 35.6 kN strength."""
+    code, out, err = _cli(capsys, "trim", "--wind", "100")
+    assert code == 2 and out == ""
+    assert err.strip().count("\n") == 0 and "tether.strength" in err
+
+
+def test_7_trim_past_the_motor_limit_warns(capsys):
+    """At 30 m/s the winch tension (10.2 kN) exceeds the 8 kN motor limit and the 11.9 kN
+    safe working load is not yet reached."""
+    code, out, err = _cli(capsys, "trim", "--wind", "30")
+    assert code == 0 and "Trim at U = 30" in out
+    assert "winch.max_motor_force" in err and "safe_working_load" not in err
+
+
+def test_7_stability_past_the_motor_limit_warns(capsys):
+    code, _, err = _cli(capsys, "stability", "--wind", "40", "--elements", "5")
+    assert code == 0
+    assert "winch.max_motor_force" in err and "winch.safe_working_load" in err
+
+
+# --- 8. bounded turbulence-bank memory --------------------------------------------------------------
+
+
+def test_8_bank_shared_across_episode_lengths_and_freed_with_its_last_env():
+    gc.collect()
+    assert episodes.cached_bank_bytes() == 0
+    short = TetheredAerostatVectorEnv(2, max_episode_steps=300, n_elements=5)
+    long = TetheredAerostatVectorEnv(2, max_episode_steps=18000, n_elements=5)  # 3600 s
+    assert long.batch.bank is short.batch.bank  # one bank for every episode length
+    nbytes = short.batch.bank.nbytes
+    assert episodes.cached_bank_bytes() == nbytes
+    assert nbytes < 200 * 2**20
+    short.close()
+    long.close()
+    del short, long
+    gc.collect()
+    assert episodes.cached_bank_bytes() == 0
+
+
+def test_8_cache_holds_at_most_max_cached_banks():
+    gc.collect()
+    envs = [TetheredAerostatVectorEnv(1, n_elements=5, wind_bank_seed=s, wind_bank_size=1)
+            for s in range(episodes.MAX_CACHED_BANKS + 2)]
+    assert len(episodes._BANKS) == episodes.MAX_CACHED_BANKS
+    for env in envs:
+        env.close()
+    del envs
+    gc.collect()
+    assert len(episodes._BANKS) == 0
+
+
+# --- 9. CLI -----------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("argv, option, value", [
+    (["train", "--timesteps", "-1"], "--timesteps", "-1"),
+    (["train", "--timesteps", "0"], "--timesteps", "0"),
+    (["train", "--n-envs", "0"], "--n-envs", "0"),
+    (["demo", "--policy", "missing.zip"], "--policy", "missing.zip"),
+    (["wind", "--duration", "-5"], "--duration", "-5"),
+    (["wind", "--ensemble", "0"], "--ensemble", "0"),
+    (["wind", "--preset", "hurricane"], "--preset", "hurricane"),
+    (["trim", "--wind", "-3"], "--wind", "-3"),
+    (["trim", "--wind", "nan"], "--wind", "nan"),
+    (["trim", "--config", "missing.toml"], "--config", "missing.toml"),
+    (["stability", "--elements", "0"], "--elements", "0"),
+    (["stability", "--wind", "5:2"], "--wind", "5:2"),
+])
+def test_9_bad_cli_values_are_one_line_on_stderr_with_status_2(capsys, argv, option, value):
+    code, out, err = _cli(capsys, *argv)
+    assert code == 2
+    assert out == ""
+    line = err.strip()
+    assert line.count("\n") == 0 and "Traceback" not in line
+    assert option in line and value in line
+
+
+def test_9_wind_input_errors_go_to_stderr(capsys):
+    """A reference height outside the field's heights is refused by the wind module: the
+    message goes to stderr, not stdout."""
+    code, out, err = _cli(capsys, "wind", "--height", "5000", "--duration", "10")
+    assert code == 2 and out == "" and "error" in err
+
+
+# --- 10. domain randomisation -----------------------------------------------------------------------
+
+
+def test_10_infeasible_randomisation_range_refused_when_made():
+    """mass +90 % (619 kg) leaves no net lift: refused at make, naming the key."""
+    with pytest.raises(TaskError, match=r"randomize\['aerostat.mass'\]"):
+        TetheredAerostatEnv(randomize={"aerostat.mass": 0.9}, n_elements=5, **QUIET)
+
+
+def test_10_wide_randomisation_resets_never_raise():
+    """+-90 % on the estimated inertias and coefficients: 40 resets, all feasible trims."""
+    spec = {"aerostat.Ixx": 0.9, "aerostat.Iyy": 0.9, "aerostat.Izz": 0.9, "hull.Cdc": 0.9,
+            "hull.eta_k": 0.9, "fins.CL_alpha": 0.9, "tether.Cd_normal": 0.9}
+    env = TetheredAerostatEnv(randomize=spec, n_elements=5, wind_speed=(3.0, 15.0), **QUIET)
+    for seed in range(40):
+        obs, info = env.reset(seed=seed)
+        assert np.all(np.isfinite(obs))
+        ratio = env.episode.params.aerostat.Ixx / 3135.0
+        assert 0.1 - 1e-12 <= ratio <= 1.9 + 1e-12
+
+
+# --- 11. action coercion ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("action", ["0.5", 0.5 + 1j, None, True, np.array([True]),
+                                    np.array(["a"]), [None], np.array([0.1 + 0j])])
+def test_11_non_real_actions_refused(action):
+    env = TetheredAerostatEnv(n_elements=5, **QUIET)
+    env.reset(seed=0)
+    with pytest.raises(ActionError, match="action"):
+        env.step(action)
+
+
+@pytest.mark.parametrize("shape", [(2, 2), (1, 4), (4, 1, 1), (3,), (8,)])
+def test_11_wrong_vector_shapes_refused(shape):
+    env = TetheredAerostatVectorEnv(4, n_elements=5, **QUIET)
+    env.reset(seed=0)
+    with pytest.raises(ActionError, match=r"\(4,\)"):
+        env.step(np.zeros(shape))
+
+
+@pytest.mark.parametrize("action", [0.3, 1, np.float32(0.3), [0.3], (0.3,), [[0.3]],
+                                    np.array([0.3], np.float32), np.array(0.3)])
+def test_11_what_gymnasium_users_pass_is_accepted(action):
+    env = TetheredAerostatEnv(n_elements=5, **QUIET)
+    env.reset(seed=0)
+    env.step(action)
+    assert env._batch.action[0] == pytest.approx(float(np.ravel(action)[0]), abs=1e-7)
+
+
+# --- 12. large n_elements ---------------------------------------------------------------------------
+
+
+def test_12_banded_jacobian_equals_the_column_by_column_one():
+    """The grouped finite differences give the same Jacobian as perturbing one unknown at a
+    time (to 1e-9 of its largest entry), with 30 residual evaluations whatever n."""
+    p = load_params(overrides={"tether.n_elements": 12})
+    eq = find_equilibrium(p, 8.0)
+    model = Model(p, 0.0)
+    trim_module._set_speed(model, p, 8.0)
+    idx = trim_module._unknown_index(model)
+    steps = np.full(idx.size, 1e-5)
+    r = trim_module._residual(model, eq.x)
+    J = trim_module._jacobian(model, eq.x, idx, steps, r.size)
+    full = np.empty_like(J)
+    for k, i in enumerate(idx):
+        xp, xm = eq.x.copy(), eq.x.copy()
+        xp[i] += 1e-5
+        xm[i] -= 1e-5
+        full[:, k] = (trim_module._residual(model, xp) - trim_module._residual(model, xm)) / 2e-5
+    assert np.max(np.abs(J - full)) <= 1e-9 * np.max(np.abs(full))
+    for n in (12, 300):
+        model_n = Model(p.replace(**{"tether.n_elements": n}), 0.0)
+        groups = trim_module._column_groups(model_n, trim_module._unknown_index(model_n).size)
+        assert len(groups) == 15
+
+
+def test_12_fine_tether_trim_converges_to_the_coarse_one():
+    """n = 120 (366 unknowns, the sparse solve): the winch tension at 10 m/s agrees with
+    n = 10's 2978.67 N to 0.01 % (the lumped-mass discretisation converges)."""
+    coarse = find_equilibrium(load_params(), 10.0).summary["winch_tension_N"]
+    fine = find_equilibrium(load_params(overrides={"tether.n_elements": 120}), 10.0)
+    assert coarse == pytest.approx(2978.67, abs=0.01)
+    assert fine.summary["winch_tension_N"] == pytest.approx(coarse, rel=1e-4)
+    assert fine.residual <= trim_module.REL_TOL
+
+
+@pytest.mark.slow
+def test_12_trim_at_400_elements_converges():
+    fine = find_equilibrium(load_params(overrides={"tether.n_elements": 400}), 10.0)
+    assert fine.summary["winch_tension_N"] == pytest.approx(2978.67, rel=1e-4)
+
+
+def test_12_n_elements_bounded_with_a_clear_error():
+    with pytest.raises(ParameterError, match=f"tether.n_elements must be an integer in \\[1, "
+                                             f"{MAX_ELEMENTS}\\]"):
+        load_params(overrides={"tether.n_elements": MAX_ELEMENTS + 1})
+
+
+# --- soak (smoke) and memory -------------------------------------------------------------------------
+
+
+def test_soak_smoke_counts_are_zero():
+    """A short soak over a 12-configuration slice of the grid (both integrators, every
+    turbulence preset, winds 0.5-35 m/s, a 300 s turbulent episode): nothing that should
+    never happen happens. ``scripts/soak.py`` runs the full grid (10^6 steps)."""
+    from aerostat_gym.bench.soak import configurations, run_soak
+
+    grid = configurations()
+    configs = [dict(c, max_episode_steps=min(c["max_episode_steps"], 200))
+               for c in grid[2::4]]
+    configs[6]["max_episode_steps"] = 1500  # the 100 m tether, 300 s turbulent episode
+    result = run_soak(total_steps=12 * 160, num_envs=4, configs=configs)
+    c = result["counts"]
+    assert result["errors"] == []
+    assert c["steps"] == 12 * 160
+    assert c["exceptions"] == c["nonfinite_obs"] == c["nonfinite_reward"] == 0
+    assert c["obs_outside_space"] == 0
+    assert not any(k.startswith("failure") for k in c)
+
+
+def test_memory_returns_after_closing_vector_envs():
+    from aerostat_gym.bench.soak import memory_check
+
+    m = memory_check(n_envs=12, num_envs=2)
+    assert m["delta_mb"] < 100.0
