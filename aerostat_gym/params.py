@@ -246,7 +246,8 @@ def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
         return value
     if check == INT_GE1:
         if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_ELEMENTS:
-            raise ParameterError(f"{name} must be an integer in [1, {MAX_ELEMENTS}], got {value!r}")
+            raise ParameterError(f"{name} must be an integer >= 1 and <= {MAX_ELEMENTS}, got "
+                                 f"{value!r}")
         return int(value)
     if not _is_number(value):
         raise ParameterError(f"{name} must be a number, got {value!r}")

@@ -12,7 +12,7 @@ from scipy.linalg import expm
 from aerostat_gym.analysis.linear import ACTUATORS, U_FREE, input_jacobian
 from aerostat_gym.analysis.manoeuvre import length_hold_law, reel_manoeuvre
 from aerostat_gym.analysis.trim import find_equilibrium
-from aerostat_gym.params import load_params
+from aerostat_gym.params import ParameterError, load_params
 from aerostat_gym.physics.packing import P_MU
 from aerostat_gym.sim import Model, SimulationError, simulate
 from aerostat_gym.sim.winch import WinchController, WinchInputError, motor_force
@@ -67,10 +67,10 @@ def test_lumped_model_carries_the_paid_out_mass(base):
 
 
 def test_drum_must_hold_the_line(base):
-    """total_line_length below max_length is a clear error naming both fields."""
-    p = base.replace(**{"winch.total_line_length": 350.0})
-    with pytest.raises(ValueError, match="total_line_length.*max_length"):
-        WinchController(p)
+    """total_line_length below max_length is a clear error naming both fields, raised when the
+    parameters are loaded (issue 14), before any winch is built."""
+    with pytest.raises(ParameterError, match="total_line_length.*max_length"):
+        base.replace(**{"winch.total_line_length": 350.0})
 
 
 # --- brake: the fixed-length model ---------------------------------------------------------------

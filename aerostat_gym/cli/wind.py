@@ -17,7 +17,6 @@ from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
 from ..wind.field import build_wind, field_heights, field_times
 from ..wind.presets import METHODS, PRESETS, get_preset
 from ..wind.spectra import MODELS
-from .common import nonneg_float, positive_float, positive_int
 from ..wind.stats import (
     COMPONENTS,
     ensemble_coherence,
@@ -28,6 +27,7 @@ from ..wind.stats import (
     target_psd,
     welch_psd,
 )
+from .common import nonneg_float, positive_float, positive_int
 
 
 def add_wind_parser(subparsers) -> argparse.ArgumentParser:

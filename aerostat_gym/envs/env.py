@@ -49,9 +49,14 @@ class TetheredAerostatEnv(gym.Env):
     maximum speed (``winch.max_speed``, 1 m/s by default); positive pays out. The winch's
     speed loop (time constant, acceleration and motor-force limits) follows the set-point;
     set-points below ``winch.brake_speed`` engage the brake, which clamps the drum once it has
-    slowed down (so action 0 is the passive, braked winch). Out-of-range actions are clipped
-    to [-1, 1] (counted in ``info["action_clipped"]``); a NaN or infinite action raises
-    :class:`aerostat_gym.envs.ActionError` naming the value.
+    slowed down (so action 0 is the passive, braked winch). Over-hauled (the tether tension
+    above the motor's force limit, ``winch.max_motor_force``, from about 27 m/s with the
+    baseline), the winch sets its holding brake against reel-in and hold commands and pays out
+    no faster than ``winch.max_speed`` on pay-out commands. Out-of-range actions are clipped
+    to [-1, 1] (counted in ``info["action_clipped"]``). Accepted: a real number, or a list,
+    tuple or array of real numbers of shape (1,) or (1, 1); a NaN or infinite action, a
+    string, None, a boolean, a complex number or another shape raises
+    :class:`aerostat_gym.envs.ActionError` naming what was given.
 
     ## Observation Space
 

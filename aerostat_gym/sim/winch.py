@@ -171,8 +171,7 @@ class WinchController:
     """
 
     def __init__(self, params: Params | None = None):
-        self.params = params or load_params()
-        w = self.params.winch
+        self.params = params or load_params()  # total_line_length >= max_length checked at load
         self.layout = StateLayout(self.params.tether.n_elements)
         self.mu = self.params.derived.mass_per_length
         self.thresholds = WinchThresholds.from_params(self.params)
