@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import argparse
 
-from aerostat_gym.analysis.sideslip import OFFSETS_DEG, max_sideslip, yaw_curve
+from aerostat_gym.agents.sideslip import OFFSETS_DEG, max_sideslip, yaw_curve
 
 
 def main(argv=None) -> int:

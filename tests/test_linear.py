@@ -6,7 +6,6 @@ Measured values quoted in the docstrings are for the shipped baseline parameters
 
 import argparse
 import json
-import math
 
 import numpy as np
 import pytest
@@ -381,12 +380,14 @@ def test_cli_stability_and_table2(capsys, tmp_path):
     assert [r["key"] for r in rows] == list(TABLE2)
 
 
-def test_bench_sweep_within_budget():
-    """The 41-speed sweep, trims included, runs within the 10 s budget (measured ~0.4 s on 2
-    cores)."""
+def test_bench_sweep_reports():
+    """The sweep benchmark runs the 41 speeds of Figure 9, all stable, and its derived figures
+    follow from its measurement (the time itself belongs to ``aerostat-gym bench``, not to a
+    test)."""
     res = bench_sweep(repeats=1)
     assert res["n_speeds"] == 41 and res["all_stable"]
-    assert res["linear_sweep_s"] <= 10.0
+    assert res["per_speed_ms"] == pytest.approx(1e3 * res["linear_sweep_s"] / 41, rel=1e-12)
+    assert res["within_budget"] == (res["linear_sweep_s"] <= res["budget_s"])
 
 
 # --- full tables and scripts (about 7 s together) -----------------------------------------
@@ -434,6 +435,10 @@ def test_length_and_pitch_families_stable(base):
 
 
 def test_mode_rows_are_json(sweep):
-    """Sweep.rows() is plain JSON (no inf/nan)."""
-    text = json.dumps(sweep.rows(), allow_nan=False)
-    assert math.isfinite(len(text))
+    """Sweep.rows() is plain JSON (no inf/nan; json.dumps with allow_nan=False would raise) that
+    round-trips exactly, with one row per tracked mode and speed."""
+    rows = sweep.rows()
+    text = json.dumps(rows, allow_nan=False)
+    assert json.loads(text) == rows
+    expected = sum(m is not None for s in ("long", "lat") for _, t in sweep.tracks[s] for m in t)
+    assert len(rows) == expected > 0

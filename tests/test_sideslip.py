@@ -1,10 +1,10 @@
 """The yaw-departure figures of the README ("Known limitation: yaw departures at large
-sideslip"), measured by aerostat_gym.analysis.sideslip (scripts/sideslip_departures.py)."""
+sideslip"), measured by aerostat_gym.agents.sideslip (scripts/sideslip_departures.py)."""
 
 import numpy as np
 import pytest
 
-from aerostat_gym.analysis import sideslip as script
+from aerostat_gym.agents import sideslip as script
 
 
 def test_sideslip_closed_form():

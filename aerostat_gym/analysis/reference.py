@@ -13,6 +13,8 @@ from __future__ import annotations
 import math
 
 from ..params import Params, load_params
+from .modes import analyse
+from .trim import find_equilibrium
 
 #: [LN02] Table 2, "Comparison of theoretical and linear model results for period tau_n of
 #: certain oscillatory modes for baseline case" (L = 300 m, theta_0 = -4 deg; theory at U = 0,
@@ -106,9 +108,6 @@ def table2(params: Params | None = None, wind_speed: float = TABLE2_WIND) -> lis
     closed form from the parameters), its linear model at ``wind_speed``, the % difference
     between them, and the % difference from the paper's linear value with the acceptance band.
     """
-    from .modes import analyse
-    from .trim import find_equilibrium
-
     p = params or load_params()
     theory = reference_periods(p)
     linear = linear_table2_periods(analyse(p, find_equilibrium(p, wind_speed)))

@@ -7,7 +7,10 @@ from __future__ import annotations
 import os
 import time
 
+import gymnasium as gym
 import numpy as np
+
+from ..registration import ENV_ID, register
 
 KW = {"control_step": 0.1, "turbulence": "moderate"}
 
@@ -22,9 +25,7 @@ def _median_rate(fn, steps: int, repeats: int) -> float:
 
 
 def _single(integrator: str, steps: int, repeats: int) -> float:
-    import gymnasium as gym
-
-    env = gym.make("TetheredAerostat-v0", integrator=integrator, **KW)
+    env = gym.make(ENV_ID, integrator=integrator, **KW)
     env.reset(seed=0)
     rng = np.random.default_rng(0)
     actions = rng.uniform(-0.3, 0.3, (steps, 1)).astype(np.float32)
@@ -55,16 +56,13 @@ def _vector(make, num_envs: int, steps: int, repeats: int) -> float:
 
 
 def bench_env(quick: bool = False) -> dict:
-    import gymnasium as gym
-
-    import aerostat_gym  # noqa: F401
-
+    register()
     reps = 3 if quick else 5
     n_vec = 256 if quick else 1024
-    native = _vector(lambda n: gym.make_vec("TetheredAerostat-v0", num_envs=n,
+    native = _vector(lambda n: gym.make_vec(ENV_ID, num_envs=n,
                                             vectorization_mode="vector_entry_point", **KW),
                      n_vec, 20 if quick else 100, reps)
-    sync = _vector(lambda n: gym.make_vec("TetheredAerostat-v0", num_envs=n,
+    sync = _vector(lambda n: gym.make_vec(ENV_ID, num_envs=n,
                                           vectorization_mode="sync", **KW),
                    64, 20 if quick else 50, reps)
     return {

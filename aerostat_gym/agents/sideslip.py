@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..analysis.trim import find_equilibrium
 from ..envs.spaces import CHANNELS, OBS_WIND_X, OBS_WIND_Y, OBS_WIND_Z
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import load_params
 from ..physics.core import rotation_matrix
 from ..sim import Model
-from .trim import find_equilibrium
 
 OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 80, 100)
 WIND = [OBS_WIND_X, OBS_WIND_Y, OBS_WIND_Z]  # measured air velocity at the CM
