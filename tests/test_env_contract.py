@@ -11,23 +11,8 @@ import aerostat_gym  # noqa: F401  (registers the environment)
 from aerostat_gym.envs import spaces
 from aerostat_gym.envs.reward import REWARD_TERMS
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
+from aerostat_gym.physics import state as st
 from aerostat_gym.physics.core import rotation_matrix
-from aerostat_gym.physics.state import (
-    S_LENGTH,
-    S_P,
-    S_PHI,
-    S_PSI,
-    S_Q,
-    S_R,
-    S_REEL,
-    S_THETA,
-    S_VX,
-    S_VY,
-    S_VZ,
-    S_X,
-    S_Y,
-    S_Z,
-)
 from aerostat_gym.sim import Model
 from aerostat_gym.sim.winch import WinchController
 
@@ -35,12 +20,12 @@ CALM = {"turbulence": "none", "perturbation": "none"}
 
 #: (state offset in the aerostat block, displacement in SI units, observation channel)
 DISPLACEMENTS = [
-    (S_X, 1.0, spaces.OBS_DX), (S_Y, -2.0, spaces.OBS_DY), (S_Z, 0.5, spaces.OBS_DZ),
-    (S_VX, 0.3, spaces.OBS_VX), (S_VY, -0.2, spaces.OBS_VY), (S_VZ, 0.1, spaces.OBS_VZ),
-    (S_PHI, 0.02, spaces.OBS_DROLL), (S_THETA, -0.01, spaces.OBS_DPITCH),
-    (S_PSI, 0.03, spaces.OBS_DYAW), (S_P, 0.004, spaces.OBS_P), (S_Q, -0.006, spaces.OBS_Q),
-    (S_R, 0.008, spaces.OBS_R), (S_LENGTH, 2.0, spaces.OBS_DLENGTH),
-    (S_REEL, 0.4, spaces.OBS_REEL_SPEED),
+    (st.S_X, 1.0, spaces.OBS_DX), (st.S_Y, -2.0, spaces.OBS_DY), (st.S_Z, 0.5, spaces.OBS_DZ),
+    (st.S_VX, 0.3, spaces.OBS_VX), (st.S_VY, -0.2, spaces.OBS_VY), (st.S_VZ, 0.1, spaces.OBS_VZ),
+    (st.S_PHI, 0.02, spaces.OBS_DROLL), (st.S_THETA, -0.01, spaces.OBS_DPITCH),
+    (st.S_PSI, 0.03, spaces.OBS_DYAW), (st.S_P, 0.004, spaces.OBS_P), (st.S_Q, -0.006, spaces.OBS_Q),
+    (st.S_R, 0.008, spaces.OBS_R), (st.S_LENGTH, 2.0, spaces.OBS_DLENGTH),
+    (st.S_REEL, 0.4, spaces.OBS_REEL_SPEED),
 ]
 
 
@@ -84,7 +69,7 @@ def test_nose_up_is_a_negative_pitch_observation(calm_env):
     b = calm_env._batch
     b.state[0] = b.trim_state[0]
     euler = b.state[0, b.layout.euler].copy()
-    b.state[0, b.layout.aerostat + S_THETA] -= 0.01
+    b.state[0, b.layout.aerostat + st.S_THETA] -= 0.01
     b.observe(0)
     nose_before = rotation_matrix(*euler)[:, 0]
     nose_after = rotation_matrix(*b.state[0, b.layout.euler])[:, 0]

@@ -144,6 +144,9 @@ class TetheredAerostatEnv(gym.Env):
     ## Version History
 
     - v0: initial release (aerostat-gym 0.1).
+    - v0, unchanged dynamics, observation and reward (bit-identical episodes): ``reward_fn``
+      argument, ``info["peak_tension"]``, ``get_state`` / ``set_state``; the pitch channel's
+      documented sign corrected (positive is nose down, as it always was).
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
