@@ -107,7 +107,7 @@ def test_full_training_reaches_shipped_score(tmp_path):
     from aerostat_gym.agents.evaluate import suite_score
 
     run = train("ppo", seed=0, run_dir=tmp_path / "full", progress_bar=False)
-    shipped = suite_score(load_policy("agents/ppo_tethered_aerostat.zip"), "damping")
+    shipped = suite_score(load_policy("shipped"), "damping")
     best = max(e["score"] for e in json.loads((run / "evaluations.json").read_text()))
     assert best >= shipped - 0.1 * abs(shipped)
 

@@ -20,10 +20,13 @@ import numpy as np
 
 from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION
 from ..params import load_params
+from ..resources import SHIPPED_POLICY, shipped_path
 from .lqr import LQRPolicy
 from .sb3io import PolicyError, as_batch, load_sb3, to_actions
 
 BASELINES = ("passive", "tension", "lqr")
+#: Names of trained policies that ship with the package.
+SHIPPED = {"shipped": SHIPPED_POLICY}
 
 
 class PassivePolicy:
@@ -62,13 +65,17 @@ class TensionFeedbackPolicy:
 
 
 def load_policy(name: str, params=None, dt: float = 0.2):
-    """A baseline by name ('passive', 'tension', 'lqr') or a saved SB3 model (path to .zip)."""
+    """A baseline by name ('passive', 'tension', 'lqr'), a shipped trained policy by name
+    ('shipped': the package's default PPO policy) or a saved SB3 model (path to .zip)."""
     if name == "passive":
         return PassivePolicy()
     if name == "tension":
         return TensionFeedbackPolicy()
     if name == "lqr":
         return LQRPolicy(params or load_params(), dt=dt)
+    if name in SHIPPED:
+        return load_sb3(shipped_path(SHIPPED[name]))
     if name.endswith(".zip") or Path(name).exists():
         return load_sb3(name)
-    raise PolicyError(f"unknown policy {name!r}: use one of {BASELINES} or a path to a .zip")
+    raise PolicyError(f"unknown policy {name!r}: use one of {BASELINES + tuple(SHIPPED)} or a "
+                      "path to a .zip")

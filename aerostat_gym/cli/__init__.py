@@ -20,10 +20,22 @@ from .model import add_model_parsers
 from .stability import add_stability_parsers
 from .wind import add_wind_parser
 
+DESCRIPTION = ("Tethered-aerostat simulator (Lambert & Nahon 2002), linear stability analysis and "
+               "winch-control agents. Run 'aerostat-gym COMMAND --help' for a command's options.")
+
+
+class Parser(argparse.ArgumentParser):
+    """Every command's parser shows each option's default in its help."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", argparse.ArgumentDefaultsHelpFormatter)
+        super().__init__(*args, **kwargs)
+
 
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="aerostat-gym", description=__doc__.split("\n")[0])
-    sub = ap.add_subparsers(dest="command", required=True)
+    ap = Parser(prog="aerostat-gym", description=DESCRIPTION)
+    sub = ap.add_subparsers(dest="command", required=True, parser_class=Parser,
+                            metavar="COMMAND")
     add_model_parsers(sub)
     add_wind_parser(sub)
     add_stability_parsers(sub)
@@ -35,7 +47,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (ParameterError, ValueError, RuntimeError) as exc:
+    except (ParameterError, ValueError, RuntimeError, FileNotFoundError) as exc:
         print(f"aerostat-gym {args.command}: error: {exc}", file=sys.stderr)
         return 2
 
