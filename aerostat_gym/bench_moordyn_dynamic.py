@@ -79,6 +79,7 @@ Named modelling differences and their switches (``variant`` of :func:`run_case`)
 
 from __future__ import annotations
 
+import ctypes
 import math
 import os
 import tempfile
@@ -106,7 +107,7 @@ from .bench_peer import (
 from .params import Params, load_params
 from .physics.core import rhs
 from .physics.integrators import NONFINITE, OK, si_advance
-from .physics.layout import P_NEL
+from .physics.layout import P_CDN, P_DASHPOT, P_DIAM, P_EA, P_G, P_MU, P_NEL, P_RHO
 from .simulation import BRAKED, Model
 
 OUTPUT_DT = 0.05  # s between compared samples (= the semi-implicit step)
@@ -116,7 +117,10 @@ WINDOW = 60.0  # s compared
 SETTLE = 30.0  # s with the top end held at the trim before the drive starts
 POSITION_TARGET_PCT = 0.5  # issue 20: node positions within 0.5 % of L (max over the window)
 TENSION_TARGET_PCT = 2.0  # issue 20: tensions within 2 % RMS of the mean tension
-VARIANTS = ("baseline", "crossflow_drag", "no_buoyancy", "no_damping")
+VARIANTS = ("baseline", "crossflow_drag", "moordyn_drag", "no_buoyancy", "moordyn_slack_rule",
+            "moordyn_drag_and_slack_rule", "no_damping")
+#: our-side switches (bits of the swap vector's flags) per variant
+_SWAPS = {"moordyn_drag": 2, "moordyn_slack_rule": 1, "moordyn_drag_and_slack_rule": 3}
 DIRECTIONS = {"along": (1.0, 0.0, 0.0), "across": (0.0, 1.0, 0.0), "vertical": (0.0, 0.0, 1.0)}
 
 # path kinds and the packed path vector (read by the compiled drivers)
@@ -306,30 +310,155 @@ def _all_finite(x):
 
 
 @njit(cache=True)
-def driven_rk4(x, t, h, nsteps, path, u, p, wp, wf, w):
+def moordyn_segment_tension(x, p, w, e):
+    """Axial force of element e under MoorDyn's rule (``Line::getStateDeriv``): the elastic
+    part EA (l - l_u) / l_u only when stretched, plus the dashpot BA ldot / l_u (BA = b = c* l_u)
+    always, so it acts on slack segments and may push; the strain rate has no unstretched-length
+    term (ours: c* (ldot - l Ldot / L), the total clipped at zero). From the node positions and
+    velocities of a work array filled by ``rhs``."""
+    n = int(p[P_NEL])
+    l_u = x[6 * (n - 1) + LENGTH] / n
+    pos, vel = w[:3 * (n + 1)], w[3 * (n + 1):6 * (n + 1)]
+    a = 3 * e
+    d0, d1, d2 = pos[a] - pos[a + 3], pos[a + 1] - pos[a + 4], pos[a + 2] - pos[a + 5]
+    ln = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    ldot = (d0 * (vel[a] - vel[a + 3]) + d1 * (vel[a + 1] - vel[a + 4])
+            + d2 * (vel[a + 2] - vel[a + 5])) / ln
+    elastic = p[P_EA] * (ln / l_u - 1.0) if ln > l_u else 0.0
+    return elastic + p[P_DASHPOT] * ldot, d0 / ln, d1 / ln, d2 / ln
+
+
+@njit(cache=True)
+def _apply_moordyn_rule(x, p, w, dx):
+    """Replace our element tensions in the node accelerations dx by MoorDyn's rule
+    (:func:`moordyn_segment_tension`): the switch that removes the damping-clip difference."""
+    n = int(p[P_NEL])
+    T0 = 9 * (n + 1)
+    im_node = n / (p[P_MU] * x[6 * (n - 1) + LENGTH])
+    for e in range(n):
+        T, ex, ey, ez = moordyn_segment_tension(x, p, w, e)
+        dT = (T - w[T0 + e]) * im_node
+        # node e (upper) is pulled toward the lower node by -T e; node e + 1 by +T e
+        if e > 0:
+            _add3(dx, 3 * (n - 1) + 3 * (e - 1), -dT * ex, -dT * ey, -dT * ez)
+        if e < n - 1:
+            _add3(dx, 3 * (n - 1) + 3 * e, dT * ex, dT * ey, dT * ez)
+
+
+@njit(cache=True)
+def _add3(a, i, vx, vy, vz):
+    a[i] += vx
+    a[i + 1] += vy
+    a[i + 2] += vz
+
+
+@njit(cache=True)
+def _unit(w, i, j):
+    """Unit vector from node j to node i (positions in the work array) and the distance."""
+    dx, dy, dz = w[3 * i] - w[3 * j], w[3 * i + 1] - w[3 * j + 1], w[3 * i + 2] - w[3 * j + 2]
+    d = math.sqrt(dx * dx + dy * dy + dz * dz)
+    return dx / d, dy / d, dz / d, d
+
+
+@njit(cache=True)
+def moordyn_node_drag(x, p, w, j, swap):
+    """MoorDyn's drag on node j (``Line::getStateDeriv``): the relative flow
+    u = U - v_j split along the node tangent q (internal nodes: from node j - 1 to j + 1; end
+    nodes: their segment), D = 0.5 rho d l (Cd |u_p| u_p + pi CdAx |u_q| u_q) with l the node's
+    share of the line (l_u inside, l_u / 2 at the ends), U = (swap[1], swap[2], swap[3]) the
+    uniform current and CdAx = swap[4]."""
+    n = int(p[P_NEL])
+    l_u = x[6 * (n - 1) + LENGTH] / n
+    i0, i1 = max(j - 1, 0), min(j + 1, n)
+    qx, qy, qz, _ = _unit(w, i1, i0)
+    length = l_u if 0 < j < n else 0.5 * l_u
+    V = 3 * (n + 1)
+    ux = swap[1] - w[V + 3 * j]
+    uy = swap[2] - w[V + 3 * j + 1]
+    uz = swap[3] - w[V + 3 * j + 2]
+    uq = ux * qx + uy * qy + uz * qz
+    px, py, pz = ux - uq * qx, uy - uq * qy, uz - uq * qz
+    c = 0.5 * p[P_RHO] * p[P_DIAM] * length
+    kp = c * p[P_CDN] * math.sqrt(px * px + py * py + pz * pz)
+    kq = c * math.pi * swap[4] * abs(uq)
+    return kp * px + kq * uq * qx, kp * py + kq * uq * qy, kp * pz + kq * uq * qz
+
+
+@njit(cache=True)
+def our_node_drag(x, p, w, j):
+    """Our drag on node j (half of each adjacent element's), recovered from the node force in
+    the work array: F_j - (tension terms) + weight."""
+    n = int(p[P_NEL])
+    F, T0 = 6 * (n + 1), 9 * (n + 1)
+    g = p[P_MU] * x[6 * (n - 1) + LENGTH] / n * p[P_G] * (0.5 if j == 0 or j == n else 1.0)
+    fx, fy, fz = w[F + 3 * j], w[F + 3 * j + 1], w[F + 3 * j + 2] + g
+    if j > 0:  # element j - 1 above pulls node j up along its unit vector (upper minus lower)
+        ex, ey, ez, _ = _unit(w, j - 1, j)
+        T = w[T0 + j - 1]
+        fx, fy, fz = fx - T * ex, fy - T * ey, fz - T * ez
+    if j < n:
+        ex, ey, ez, _ = _unit(w, j, j + 1)
+        T = w[T0 + j]
+        fx, fy, fz = fx + T * ex, fy + T * ey, fz + T * ez
+    return fx, fy, fz
+
+
+@njit(cache=True)
+def _apply_moordyn_drag(x, p, w, dx, swap):
+    """Replace our element-midpoint drag with loading functions in the node accelerations dx
+    by MoorDyn's nodal crossflow drag (:func:`moordyn_node_drag`): the drag-law switch."""
+    n = int(p[P_NEL])
+    im_node = n / (p[P_MU] * x[6 * (n - 1) + LENGTH])
+    for j in range(1, n):
+        mx, my, mz = moordyn_node_drag(x, p, w, j, swap)
+        ox, oy, oz = our_node_drag(x, p, w, j)
+        _add3(dx, 3 * (n - 1) + 3 * (j - 1), (mx - ox) * im_node, (my - oy) * im_node,
+              (mz - oz) * im_node)
+
+
+SWAP_SEGMENT_RULE, SWAP_NODAL_DRAG = 1, 2  # bits of swap[0]
+NO_SWAP = np.zeros(5)
+
+
+@njit(cache=True)
+def _rhs_swapped(t, x, u, p, wp, wf, dx, w, swap):
+    """Our right-hand side, with MoorDyn's segment rule and / or nodal drag in place of ours as
+    the bits of swap[0] ask (``SWAP_SEGMENT_RULE``, ``SWAP_NODAL_DRAG``)."""
+    rhs(t, x, u, p, wp, wf, dx, w)
+    flags = int(swap[0])
+    if flags & SWAP_NODAL_DRAG:
+        _apply_moordyn_drag(x, p, w, dx, swap)
+    if flags & SWAP_SEGMENT_RULE:
+        _apply_moordyn_rule(x, p, w, dx)
+
+
+@njit(cache=True)
+def driven_rk4(x, t, h, nsteps, path, u, p, wp, wf, w, swap):
     """Advance the tether-only state x in place by ``nsteps`` RK4 steps of size h from time t,
     the top end (and unstretched length) on ``path`` at every stage time. The model must have
     the aerostat fixed (its derivatives zero) and u must brake the winch (L' = 0), so the RK4
-    update leaves the overwritten entries alone. Returns OK or NONFINITE."""
+    update leaves the overwritten entries alone. ``swap`` (``NO_SWAP``, or see
+    :func:`_rhs_swapped`) puts MoorDyn's segment rule or nodal drag in place of ours. Returns OK
+    or NONFINITE."""
     m = x.size
     o = 6 * (int(p[P_NEL]) - 1)
     k1, k2, k3, k4, xt = np.empty(m), np.empty(m), np.empty(m), np.empty(m), np.empty(m)
     for s in range(nsteps):
         ts = t + s * h
         _place_top(x, o, path, ts, 0.0)
-        rhs(ts, x, u, p, wp, wf, k1, w)
+        _rhs_swapped(ts, x, u, p, wp, wf, k1, w, swap)
         for i in range(m):
             xt[i] = x[i] + 0.5 * h * k1[i]
         _place_top(xt, o, path, ts + 0.5 * h, 0.0)
-        rhs(ts + 0.5 * h, xt, u, p, wp, wf, k2, w)
+        _rhs_swapped(ts + 0.5 * h, xt, u, p, wp, wf, k2, w, swap)
         for i in range(m):
             xt[i] = x[i] + 0.5 * h * k2[i]
         _place_top(xt, o, path, ts + 0.5 * h, 0.0)
-        rhs(ts + 0.5 * h, xt, u, p, wp, wf, k3, w)
+        _rhs_swapped(ts + 0.5 * h, xt, u, p, wp, wf, k3, w, swap)
         for i in range(m):
             xt[i] = x[i] + h * k3[i]
         _place_top(xt, o, path, ts + h, 0.0)
-        rhs(ts + h, xt, u, p, wp, wf, k4, w)
+        _rhs_swapped(ts + h, xt, u, p, wp, wf, k4, w, swap)
         for i in range(m):
             x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
     _place_top(x, o, path, t + nsteps * h, 0.0)
@@ -337,11 +466,12 @@ def driven_rk4(x, t, h, nsteps, path, u, p, wp, wf, w):
 
 
 @njit(cache=True)
-def driven_si(x, t, h, nsteps, path, u, p, wp, wf, w):
+def driven_si(x, t, h, nsteps, path, u, p, wp, wf, w, swap):
     """Advance x in place by ``nsteps`` semi-implicit steps of size h from time t, the top end
     placed on ``path`` at each step start with the secant velocity over the step (same model
     requirements as :func:`driven_rk4`). On return the top end carries its analytic velocity
-    (for outputs). Returns OK or NONFINITE."""
+    (for outputs). ``swap`` must be ``NO_SWAP`` (the semi-implicit step has no swapped
+    variant). Returns OK or NONFINITE."""
     o = 6 * (int(p[P_NEL]) - 1)
     stats = np.array([0.0, np.inf])
     for s in range(nsteps):
@@ -380,6 +510,7 @@ class _Setup:
     params: Params
     md_params: Params
     md_mass: float | None
+    swap: np.ndarray
     model: Model
     top: np.ndarray
     lever: np.ndarray
@@ -408,10 +539,33 @@ def prepare(variant: str = "baseline", settle: float = SETTLE) -> _Setup:
     x = _chord_state(model, eq.x)
     h = OUTPUT_DT / RK4_SUBSTEPS
     hold = DrivenCase("hold", SINE, period=1.0).pack(top, lever, p.tether.length)
+    swap = np.array([_SWAPS.get(variant, 0), WIND, 0.0, 0.0, axial_cdt(pmd)])
     if driven_rk4(x, -settle, h, round(settle / h), hold, BRAKED, model.p, model.wp, model.wf,
-                  model.work) != OK:
+                  model.work, swap) != OK:
         raise RuntimeError("our tether did not settle at the trim (non-finite state)")
-    return _Setup(p, pmd, mass, model, top, lever, x, settle)
+    return _Setup(p, pmd, mass, swap, model, top, lever, x, settle)
+
+
+def _end_tensions(model: Model, x: np.ndarray, swap: np.ndarray) -> tuple[float, float]:
+    """Top and bottom tension (:meth:`Model.end_tensions`), with the end elements' axial force
+    and the top node's drag from MoorDyn's rules where ``swap`` asks."""
+    flags = int(swap[0])
+    if not flags:
+        return model.end_tensions(x)
+    w = model._forces(x)
+    n, p = model.n, model.p
+    T0, F = 9 * (n + 1), 6 * (n + 1)
+    top = w[F:F + 3].copy()
+    T_bot, e_bot = w[T0 + n - 1], np.array(_unit(w, n - 1, n)[:3])
+    if flags & SWAP_SEGMENT_RULE:
+        T_top, *e_top = moordyn_segment_tension(x, p, w, 0)
+        top -= (T_top - w[T0]) * np.array(e_top)
+        T_bot, *e_bot = moordyn_segment_tension(x, p, w, n - 1)
+    if flags & SWAP_NODAL_DRAG:
+        top += np.array(moordyn_node_drag(x, p, w, 0, swap)) - np.array(our_node_drag(x, p, w, 0))
+    half_weight = 0.5 * model.params.derived.mass_per_length * x[model.layout.winch_length] / n
+    bottom = T_bot * np.asarray(e_bot) - np.array([0.0, 0.0, half_weight * model.params.environment.g])
+    return float(np.linalg.norm(top)), float(np.linalg.norm(bottom))
 
 
 def _segment_slack(nodes: np.ndarray, length: float) -> int:
@@ -431,15 +585,16 @@ def _run_ours(setup: _Setup, path: np.ndarray, case: DrivenCase, integrator: str
     n_out = round(case.duration / OUTPUT_DT)
     x = setup.x_settled.copy()
     o = m.layout.cm_pos.start
+    swap = setup.swap if integrator == "rk4" else NO_SWAP
+    args = (BRAKED, m.p, m.wp, m.wf, m.work, swap)
     nodes, top, bottom, slack = [], [], [], []
     for k in range(n_out + 1):
-        if k > 0 and fn(x, (k - 1) * OUTPUT_DT, h, nsub, path, BRAKED, m.p, m.wp, m.wf,
-                        m.work) != OK:
+        if k > 0 and fn(x, (k - 1) * OUTPUT_DT, h, nsub, path, *args) != OK:
             raise RuntimeError(f"our {integrator} run of {case.name!r} became non-finite "
                                f"at t = {k * OUTPUT_DT:.2f} s")
         pos = m.node_positions(x)
         nodes.append(pos)
-        top_t, bot_t = m.end_tensions(x)
+        top_t, bot_t = _end_tensions(m, x, swap)
         top.append(top_t)
         bottom.append(bot_t)
         slack.append(_segment_slack(pos, x[o + LENGTH]))
@@ -447,7 +602,7 @@ def _run_ours(setup: _Setup, path: np.ndarray, case: DrivenCase, integrator: str
     for _ in range(repeats):
         y = setup.x_settled.copy()
         t0 = time.perf_counter()
-        fn(y, 0.0, h, nsub * n_out, path, BRAKED, m.p, m.wp, m.wf, m.work)
+        fn(y, 0.0, h, nsub * n_out, path, *args)
         walls.append(time.perf_counter() - t0)
     return {"nodes": np.array(nodes), "top": np.array(top), "bottom": np.array(bottom),
             "slack": np.array(slack), "dt_s": h, "wall_s": float(min(walls))}
@@ -465,7 +620,9 @@ def _moordyn_schedule(path: np.ndarray, h: float, nsteps: int) -> tuple:
     d = path[K_DIR:K_DIR + 3]
     pos = path[K_TOP:K_TOP + 3] + s[:-1, None] * d
     vel = (np.diff(s) / h)[:, None] * d
-    return pos, vel, np.diff(L) / h
+    # rounded: the secant of a linear ramp carries rounding noise, and every change of the
+    # rate costs a call of MoorDyn's setter
+    return pos, vel, np.round(np.diff(L) / h, 9)
 
 
 def _run_moordyn(md, setup: _Setup, path: np.ndarray, case: DrivenCase, substeps: int,
@@ -508,7 +665,7 @@ def _run_moordyn(md, setup: _Setup, path: np.ndarray, case: DrivenCase, substeps
                 for k in range(nsteps):
                     if Ld[k] != rate:
                         rate = float(Ld[k])
-                        md.SetLineUnstretchedLengthVel(line, rate)
+                        _set_length_rate(md, line, rate)
                     md.Step(system, pos[k], vel[k], t, h)
                     t += h
                     if record and (k + 1) % substeps == 0:
@@ -522,6 +679,15 @@ def _run_moordyn(md, setup: _Setup, path: np.ndarray, case: DrivenCase, substeps
     for key in ("nodes", "top", "bottom", "slack"):
         out[key] = np.array(out[key])
     return out
+
+
+def _set_length_rate(md, line, rate: float) -> None:
+    """``SetLineUnstretchedLengthVel``. The 2.7.2 binding returns None without a new reference
+    (measured: ``sys.getrefcount(None)`` falls by one per call, and the interpreter aborts at
+    exit with "Fatal Python error: none_dealloc"), so the reference it takes is given back, for
+    good (a reference held in a list would be released at exit and abort just the same)."""
+    md.SetLineUnstretchedLengthVel(line, rate)
+    ctypes.pythonapi.Py_IncRef(ctypes.py_object(None))
 
 
 def _sample_moordyn(md, line, N: int, shift: np.ndarray, out: dict) -> None:
