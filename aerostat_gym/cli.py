@@ -73,6 +73,12 @@ def cmd_params(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    if args.moordyn_dynamic:  # issue 20: the tether in motion against MoorDyn
+        from .bench_moordyn_dynamic import format_report, run_dynamic_comparison
+
+        res = run_dynamic_comparison(quick=args.quick)
+        print(json.dumps(res, indent=2, default=float) if args.json else format_report(res))
+        return 0
     from .bench import format_text, run_bench
 
     res = run_bench(quick=args.quick)
@@ -93,6 +99,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("bench", help="speed and accuracy figures")
     p.add_argument("--json", action="store_true")
     p.add_argument("--quick", action="store_true", help="shorter runs (smoke test)")
+    p.add_argument("--moordyn-dynamic", action="store_true",
+                   help="only the dynamic comparison with MoorDyn (driven top end)")
     p.set_defaults(func=cmd_bench)
     from .analysis.stability_cli import add_stability_parsers
     from .wind.cli import add_wind_parser
