@@ -43,8 +43,8 @@ How the top end is driven
   boundary.
 
 Both codes first settle for ``settle`` seconds with the top end at the trim (MoorDyn from its own
-still-fluid initial state, ours from the straight chord, as in the static comparison); the drive
-starts at t = 0 after that.
+still-fluid initial state, ours from the straight chord with RK4, the start of both our
+integrators, as in the static comparison); the drive starts at t = 0 after that.
 
 Time steps
 ----------
