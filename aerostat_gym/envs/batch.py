@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from ..physics.integrators import scheme
@@ -29,6 +30,19 @@ from .episodes import (
 NO_BANK = np.zeros((1, 1, 0, 3))
 
 
+def check_threads(threads: int | None) -> int:
+    """Threads of the batched step: an integer from 1 to numba's NUMBA_NUM_THREADS (default:
+    all of them); anything else is a ValueError naming the value."""
+    top = numba.config.NUMBA_NUM_THREADS
+    if threads is None:
+        return top
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) \
+            or not 1 <= threads <= top:
+        raise ValueError(f"threads must be an integer from 1 to {top} (NUMBA_NUM_THREADS), got "
+                         f"{threads!r}")
+    return int(threads)
+
+
 class ActionError(ValueError):
     """A non-finite or wrongly shaped action (the message names the value)."""
 
@@ -42,9 +56,11 @@ class EnvBatch:
     horizon : longest episode [s] the turbulence must cover (None: 120 s).
     """
 
-    def __init__(self, task: TaskConfig, num_envs: int, horizon: float | None = None):
+    def __init__(self, task: TaskConfig, num_envs: int, horizon: float | None = None,
+                 threads: int | None = None):
         self.task = task
         self.num_envs = N = int(num_envs)
+        self.threads = check_threads(threads)
         params = task.params_resolved
         self.params = params
         self.layout = StateLayout(params.tether.n_elements)
@@ -197,6 +213,8 @@ class EnvBatch:
             return
         if active is None:
             active = np.ones(self.num_envs, dtype=np.bool_)
+        if numba.get_num_threads() != self.threads:
+            numba.set_num_threads(self.threads)
         K.step_parallel(active, *self._arrays())
 
     def add_noise(self, i: int, rng: np.random.Generator) -> None:
