@@ -170,3 +170,23 @@ def test_set_state_refuses_a_foreign_state():
         env.set_state(other.get_state())
     with pytest.raises(ValueError, match="get_state"):
         env.set_state({"state": 1})
+
+
+def test_threads_do_not_change_results():
+    """The batched step gives bit-identical episodes on 1 thread and on every thread."""
+    import numba
+
+    runs = []
+    for threads in (1, numba.config.NUMBA_NUM_THREADS):
+        venv = TetheredAerostatVectorEnv(num_envs=6, turbulence="moderate", threads=threads)
+        obs, _ = venv.reset(seed=2)
+        for k in range(20):
+            obs, *_ = venv.step(np.full((6, 1), 0.4 * np.sin(k / 3.0), np.float32))
+        runs.append(obs)
+    np.testing.assert_array_equal(runs[0], runs[1])
+
+
+@pytest.mark.parametrize("threads", [0, -1, 1.5, True, 10**6])
+def test_bad_thread_count_is_refused(threads):
+    with pytest.raises(ValueError, match="threads must be an integer from 1 to"):
+        TetheredAerostatVectorEnv(num_envs=2, threads=threads)
