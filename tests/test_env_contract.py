@@ -190,3 +190,13 @@ def test_threads_do_not_change_results():
 def test_bad_thread_count_is_refused(threads):
     with pytest.raises(ValueError, match="threads must be an integer from 1 to"):
         TetheredAerostatVectorEnv(num_envs=2, threads=threads)
+
+
+def test_reward_table_documents_every_term():
+    """reward_table lists every compiled term once, with its default or overridden weight."""
+    from aerostat_gym.envs import DEFAULT_WEIGHTS, reward_table
+
+    rows = reward_table({"pitch": 0.5})
+    assert [r["term"] for r in rows] == list(REWARD_TERMS)
+    assert {r["term"]: r["weight"] for r in rows} == {**DEFAULT_WEIGHTS, "pitch": 0.5}
+    assert all(r["formula"].startswith("-w") for r in rows)
