@@ -339,9 +339,10 @@ def _chord_state(model: Model, x_trim: np.ndarray) -> np.ndarray:
     nodes = model.node_positions(x_trim)
     n = model.n
     top, bottom = nodes[0], nodes[n]
-    for k in range(1, n):
-        x[3 * (k - 1):3 * k] = top + (bottom - top) * k / n
-    x[3 * (n - 1):6 * (n - 1)] = 0.0
+    lay = model.layout
+    x[lay.node_pos] = np.concatenate([top + (bottom - top) * k / n for k in range(1, n)]) \
+        if n > 1 else x[lay.node_pos]
+    x[lay.node_vel] = 0.0
     return x
 
 

@@ -343,7 +343,7 @@ def moordyn_segment_tension(x, p, w, e):
     term (ours: c* (ldot - l Ldot / L), the total clipped at zero). From the node positions and
     velocities of a work array filled by ``rhs``."""
     n = int(p[P_NEL])
-    l_u = x[6 * (n - 1) + LENGTH] / n
+    l_u = x[aerostat_offset(n) + LENGTH] / n
     V = node_vel_offset(n)
     pos, vel = w[:V], w[V:node_force_offset(n)]
     a = 3 * e
@@ -361,7 +361,7 @@ def _apply_moordyn_rule(x, p, w, dx):
     (:func:`moordyn_segment_tension`): the switch that removes the damping-clip difference."""
     n = int(p[P_NEL])
     T0 = tension_offset(n)
-    im_node = n / (p[P_MU] * x[6 * (n - 1) + LENGTH])
+    im_node = n / (p[P_MU] * x[aerostat_offset(n) + LENGTH])
     for e in range(n):
         T, ex, ey, ez = moordyn_segment_tension(x, p, w, e)
         dT = (T - w[T0 + e]) * im_node
@@ -395,7 +395,7 @@ def moordyn_node_drag(x, p, w, j, swap):
     share of the line (l_u inside, l_u / 2 at the ends), U = (swap[1], swap[2], swap[3]) the
     uniform current and CdAx = swap[4]."""
     n = int(p[P_NEL])
-    l_u = x[6 * (n - 1) + LENGTH] / n
+    l_u = x[aerostat_offset(n) + LENGTH] / n
     i0, i1 = max(j - 1, 0), min(j + 1, n)
     qx, qy, qz, _ = _unit(w, i1, i0)
     length = l_u if 0 < j < n else 0.5 * l_u
@@ -417,7 +417,7 @@ def our_node_drag(x, p, w, j):
     the work array: F_j - (tension terms) + weight."""
     n = int(p[P_NEL])
     F, T0 = node_force_offset(n), tension_offset(n)
-    g = p[P_MU] * x[6 * (n - 1) + LENGTH] / n * p[P_G] * (0.5 if j == 0 or j == n else 1.0)
+    g = p[P_MU] * x[aerostat_offset(n) + LENGTH] / n * p[P_G] * (0.5 if j == 0 or j == n else 1.0)
     fx, fy, fz = w[F + 3 * j], w[F + 3 * j + 1], w[F + 3 * j + 2] + g
     if j > 0:  # element j - 1 above pulls node j up along its unit vector (upper minus lower)
         ex, ey, ez, _ = _unit(w, j - 1, j)
@@ -435,7 +435,7 @@ def _apply_moordyn_drag(x, p, w, dx, swap):
     """Replace our element-midpoint drag with loading functions in the node accelerations dx
     by MoorDyn's nodal crossflow drag (:func:`moordyn_node_drag`): the drag-law switch."""
     n = int(p[P_NEL])
-    im_node = n / (p[P_MU] * x[6 * (n - 1) + LENGTH])
+    im_node = n / (p[P_MU] * x[aerostat_offset(n) + LENGTH])
     for j in range(1, n):
         mx, my, mz = moordyn_node_drag(x, p, w, j, swap)
         ox, oy, oz = our_node_drag(x, p, w, j)
