@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..params import Params, apply_overrides, load_params
 from ..sim import INTEGRATORS
-from ..wind.presets import resolve_turbulence
+from ..wind.sizing import sized_turbulence
 from . import reward
 
 #: Perturbation presets: maximum along-wind swing and lateral displacement of the aerostat [m]
@@ -79,10 +79,6 @@ class TaskConfig:
     def __post_init__(self):
         r = self.resolved
         r["wind_speed"] = _range("wind_speed", self.wind_speed)
-        try:
-            r["turbulence"] = resolve_turbulence(self.turbulence)
-        except (TypeError, ValueError) as exc:
-            raise TaskError(f"turbulence: {exc}") from None
         r["perturbation"] = perturbation(self.perturbation)
         if self.integrator not in INTEGRATORS:
             raise TaskError(f"unknown integrator {self.integrator!r}; choose one of {INTEGRATORS}")
@@ -103,6 +99,10 @@ class TaskConfig:
         if not (isinstance(self.wind_bank_size, int) and self.wind_bank_size >= 1):
             raise TaskError(f"wind_bank_size must be an integer >= 1, got {self.wind_bank_size!r}")
         r["params"] = self._params()
+        try:  # the field's heights and extent follow the configured aerostat, tether and winch
+            r["turbulence"] = sized_turbulence(r["params"], self.turbulence)
+        except (TypeError, ValueError) as exc:
+            raise TaskError(f"turbulence: {exc}") from None
         r["randomize"] = self._randomize(r["params"])
 
     def _params(self) -> Params:
