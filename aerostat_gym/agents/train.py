@@ -76,19 +76,27 @@ def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize):
     return venv
 
 
-def train(algo: str, config: str | Path | None = None, timesteps: int | None = None,
+def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | None = None,
           n_envs: int | None = None, seed: int = 0, run_dir: str | Path | None = None,
           resume: str | Path | None = None, progress_bar: bool = True, threads: int | None = None,
-          eval_freq: int | None = None) -> Path:
-    """Train and return the run directory (see the module docstring)."""
+          eval_freq: int | None = None, params=None) -> Path:
+    """Train and return the run directory (see the module docstring).
+
+    ``hyperparams`` is the YAML file (default the shipped one); ``params`` the physics
+    configuration (a Params, a TOML path or a shipped name; default the YAML's ``env_kwargs``
+    or the baseline), used by the training environments and the suite evaluations and written
+    to ``params.toml`` in the run directory.
+    """
     import torch
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
     from stable_baselines3.common.utils import set_random_seed
 
-    hp = load_hyperparams(algo, config)
+    hp = load_hyperparams(algo, hyperparams)
     n_envs = int(n_envs or hp.get("n_envs", 8))
     timesteps = int(timesteps or hp.get("n_timesteps", 1e6))
     env_kwargs = dict(hp.get("env_kwargs") or {})
+    if params is not None:
+        env_kwargs["params"] = params
     run = Path(run_dir or f"runs/train/{algo}_seed{seed}_{time.strftime('%Y%m%d-%H%M%S')}")
     run.mkdir(parents=True, exist_ok=True)
     if threads:
@@ -101,7 +109,8 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     callbacks = CallbackList([
         CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"), name_prefix=algo,
                            save_vecnormalize=True),
-        suite_eval_callback(hp.get("eval_suite", "tiny"), max(freq // n_envs, 1), run),
+        suite_eval_callback(hp.get("eval_suite", "tiny"), max(freq // n_envs, 1), run,
+                            env_kwargs.get("params")),
     ])
     t0 = time.perf_counter()
     model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress_bar,
@@ -117,7 +126,7 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     return run
 
 
-def suite_eval_callback(suite: str, freq: int, run: Path):
+def suite_eval_callback(suite: str, freq: int, run: Path, params=None):
     """A callback that, every ``freq`` calls, scores the current policy on the fixed suite
     (deterministic actions, the training VecNormalize statistics), logs it, appends it to
     ``evaluations.json`` and saves the best-scoring model (with its statistics) as
@@ -141,7 +150,8 @@ def suite_eval_callback(suite: str, freq: int, run: Path):
                 self.evaluate_now()
 
         def evaluate_now(self) -> None:
-            score = suite_score(SB3Policy(self.model, self.model.get_env()), suite)
+            score = suite_score(SB3Policy(self.model, self.model.get_env()), suite,
+                                params=params)
             self.logger.record("eval/suite_score", score)
             self.history.append({"timesteps": int(self.num_timesteps), "score": score,
                                  "wall_time_s": time.perf_counter() - self.t0})

@@ -13,6 +13,7 @@ from ..agents.train import ALGOS, train
 from ..analysis.modes import analyse
 from ..analysis.trim import find_equilibrium
 from ..params import load_params
+from .common import add_config, config_label, params_from_args
 
 SHIPPED_POLICY = "agents/ppo_tethered_aerostat.zip"
 
@@ -20,7 +21,7 @@ SHIPPED_POLICY = "agents/ppo_tethered_aerostat.zip"
 def add_train_parser(sub) -> None:
     p = sub.add_parser("train", help="train a winch-control policy with Stable-Baselines3")
     p.add_argument("--algo", choices=ALGOS, default="ppo")
-    p.add_argument("--config", help="hyperparameter YAML (default agents/hyperparams/ALGO.yml)")
+    p.add_argument("--hyperparams", help="hyperparameter YAML (default agents/hyperparams/ALGO.yml)")
     p.add_argument("--timesteps", type=int, help="total environment steps (default: the YAML)")
     p.add_argument("--n-envs", type=int, help="parallel environments (default: the YAML)")
     p.add_argument("--seed", type=int, default=0)
@@ -29,12 +30,14 @@ def add_train_parser(sub) -> None:
     p.add_argument("--eval-freq", type=int, help="evaluate on the suite every N steps")
     p.add_argument("--threads", type=int, help="torch threads (default: torch's)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_config(p, json=False)
     p.set_defaults(func=_train_command)
 
 
 def _train_command(args) -> int:
-    run = train(args.algo, args.config, args.timesteps, args.n_envs, args.seed, args.run_dir,
-                args.resume, not args.no_progress, args.threads, args.eval_freq)
+    params = params_from_args(args) if (args.config or args.set) else None
+    run = train(args.algo, args.hyperparams, args.timesteps, args.n_envs, args.seed, args.run_dir,
+                args.resume, not args.no_progress, args.threads, args.eval_freq, params=params)
     print(f"run directory: {run}")
     print((run / "training_summary.json").read_text())
     return 0
@@ -48,11 +51,13 @@ def add_evaluate_parser(sub) -> None:
     p.add_argument("--out", default="runs/evaluate", help="report directory")
     p.add_argument("--json", action="store_true", help="print the metrics as JSON")
     p.add_argument("--no-plots", action="store_true")
+    add_config(p, json=False)
     p.set_defaults(func=_evaluate_command)
 
 
 def _evaluate_command(args) -> int:
-    results = run_evaluations(args.policy, args.suite, progress=not args.json)
+    results = run_evaluations(args.policy, args.suite, progress=not args.json,
+                              params=params_from_args(args))
     md = write_report(results, args.out, f"Evaluation on suite `{args.suite}`",
                       "aerostat-gym " + " ".join(sys.argv[1:]), plots=not args.no_plots)
     if args.json:
@@ -69,16 +74,20 @@ def add_demo_parser(sub) -> None:
     p.add_argument("--wind", type=float, default=10.0, help="wind speed of the summary [m/s]")
     p.add_argument("--policy", default=SHIPPED_POLICY, help="policy to compare (default: shipped)")
     p.add_argument("--out", default="runs/demo")
+    p.add_argument("--suite", choices=list(SUITES), default="tiny", help="evaluation suite")
+    add_config(p, json=False)
     p.set_defaults(func=_demo_command)
 
 
 def _demo_command(args) -> int:
     t0 = time.perf_counter()
-    policy = _shipped(args.policy)
-    params = load_params()
+    params = params_from_args(args)
+    policies = ["passive", "lqr"]
+    if params == load_params() or args.policy != SHIPPED_POLICY:
+        policies.append(_shipped(args.policy))  # the shipped policy was trained on the baseline
     eq = find_equilibrium(params, args.wind)
     s = eq.summary
-    print(f"aerostat-gym demo: baseline aerostat, L = {params.tether.length:g} m, "
+    print(f"aerostat-gym demo: {config_label(args)}, L = {params.tether.length:g} m, "
           f"U = {args.wind:g} m/s")
     x, _, z = s["aerostat_position_m"]
     print(f"  trim: CM x = {x:.1f} m, z = {z:.1f} m, blow-by {s['blow_by_deg']:.2f} deg, "
@@ -91,8 +100,9 @@ def _demo_command(args) -> int:
         if m is not None:
             name = {"long": "longitudinal", "lat": "lateral"}[subset]
             print(f"    {name:12s} {label:13s} period {m.period:7.2f} s  damping {m.zeta:.3f}")
-    results = run_evaluations(["passive", "lqr", policy], "tiny")
-    md = write_report(results, args.out, "aerostat-gym demo", "aerostat-gym demo")
+    results = run_evaluations(policies, args.suite, params=params)
+    md = write_report(results, args.out, "aerostat-gym demo", "aerostat-gym demo "
+                      + " ".join(sys.argv[1:]))
     print()
     print(comparison_table(results, "recover"))
     print(f"\nreport: {md} ({time.perf_counter() - t0:.0f} s)")

@@ -34,6 +34,10 @@ DEFAULT_RANDOMIZATION = {
 }
 
 
+#: Default range of the episode's mean wind speed [m/s].
+DEFAULT_WIND_RANGE = (3.0, 15.0)
+
+
 class TaskError(ValueError):
     """An invalid environment argument (the message names it and the value)."""
 
@@ -58,7 +62,7 @@ def _positive(name, value):
 class TaskConfig:
     """Validated environment arguments (see :class:`aerostat_gym.envs.TetheredAerostatEnv`)."""
 
-    wind_speed: tuple = (3.0, 15.0)
+    wind_speed: tuple = DEFAULT_WIND_RANGE
     turbulence: object = "moderate"
     perturbation: object = "mixed"
     tether_length: float | None = None
