@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 
-from .params import Params, ParameterError, params_from_dict, params_to_dict
+from .params import ParameterError, Params, params_from_dict, params_to_dict
 
 #: Winch length limits as fractions of the nominal tether length (the baseline's 150 / 400 m
 #: for 300 m).

@@ -31,13 +31,13 @@ from aerostat_gym.agents.lqr import (
     mode_initial_state,
     scaled_deviations,
 )
-from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.agents.metrics import fit_damped_sinusoid
-from aerostat_gym.analysis.figures import figure8_data, family_values
+from aerostat_gym.agents.policies import load_policy
+from aerostat_gym.analysis.figures import family_values, figure8_data
 from aerostat_gym.analysis.linear import ACTUATORS, U_FREE, input_jacobian
-from aerostat_gym.analysis.sensitivity import default_knobs
 from aerostat_gym.analysis.modes import analyse, wind_sweep
 from aerostat_gym.analysis.reference import THEORY_TOLERANCE_PCT
+from aerostat_gym.analysis.sensitivity import default_knobs
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.cli import main
 from aerostat_gym.envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
@@ -291,6 +291,16 @@ def test_own_aerostat_full(name, tmp_path, capsys):
     report = json.loads((tmp_path / "ev" / "report.json").read_text())
     assert all(r["tether_length_m"] == p.tether.length for r in report)
     assert all(e["ended"] is None for r in report for e in r["scenarios"]["recover"]["episodes"])
+    text = _run(capsys, ["demo", "--config", str(cfg), "--suite", "damping", "--wind", "8",
+                         "--out", str(tmp_path / "demo")])
+    assert f"L = {p.tether.length:g} m" in text
+    assert load_params(tmp_path / "demo" / "params.toml") == p
+    _no_baseline_numbers(name, text)
+    run = tmp_path / "train"
+    _run(capsys, ["train", "--algo", "ppo", "--config", str(cfg), "--timesteps", "512",
+                  "--n-envs", "2", "--seed", "0", "--run-dir", str(run), "--no-progress",
+                  "--eval-freq", "100000"])
+    assert load_params(run / "params.toml") == p
 
 
 # --- single items of the issue ----------------------------------------------------------------

@@ -1,8 +1,9 @@
 """Sensitivity of the linear results to the estimated and calibrated parameters.
 
 Most aerostat parameters of the baseline are ESTIMATE or CALIB (``parameter_table()``); this
-module moves each across its stated plausible range (docs/parameters.md; the range and its
-source are in :data:`KNOBS`) and reports how the four [LN02] Table 2 periods at U = 1 m/s and
+module moves each across a plausible range relative to the configured value (the baseline's
+documented range in docs/parameters.md as factors of its value, positions in hull lengths;
+:func:`default_knobs`) and reports how the four [LN02] Table 2 periods at U = 1 m/s and
 the smallest damping ratio of the Figure 9 modes over 1..20 m/s respond. It tells a user which
 of their own aerostat's numbers matter, and :func:`solve_for_period` says how far one knob must
 move to put a period on a target (for a documented calibration, never applied silently).

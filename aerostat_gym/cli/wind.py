@@ -17,7 +17,6 @@ from ..wind.field import build_wind, field_heights, field_times
 from ..wind.presets import METHODS, PRESETS
 from ..wind.sizing import FROM_CONFIG, sized_turbulence
 from ..wind.spectra import MODELS
-from .common import add_config, params_from_args
 from ..wind.stats import (
     COMPONENTS,
     ensemble_coherence,
@@ -28,6 +27,7 @@ from ..wind.stats import (
     target_psd,
     welch_psd,
 )
+from .common import add_config, params_from_args
 
 
 def add_wind_parser(subparsers) -> argparse.ArgumentParser:
