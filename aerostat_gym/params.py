@@ -178,6 +178,9 @@ class Params:
     winch: WinchParams
     wind: WindParams
     simulation: SimulationParams
+    #: Status of each value as the user's file states it ("section.key" -> SOURCED, ..., USER),
+    #: read from the status comments of the TOML and set to USER by overrides; not compared.
+    provenance: tuple = field(default=(), compare=False, repr=False)
 
     def replace(self, **dotted: Any) -> Params:
         """Return a copy with single values replaced, e.g. ``replace(**{"tether.length": 150})``."""
@@ -284,6 +287,7 @@ def _cross_checks(p: Params) -> None:
         raise ParameterError(
             f"winch.min_length ({p.winch.min_length}) must be < winch.max_length ({p.winch.max_length})"
         )
+    check_length_within_winch(p)
     if not -89.0 < p.aerostat.trim_pitch_deg < 89.0:
         raise ParameterError(f"aerostat.trim_pitch_deg must lie in (-89, 89), got {p.aerostat.trim_pitch_deg}")
     d = Derived.from_params(p)
@@ -292,6 +296,16 @@ def _cross_checks(p: Params) -> None:
             f"aerostat.mass = {p.aerostat.mass} kg gives no net lift (buoyancy {d.buoyancy:.1f} N "
             f"<= weight {p.aerostat.mass * p.environment.g:.1f} N)"
         )
+
+
+def check_length_within_winch(p: Params) -> None:
+    """The paid-out tether length must lie inside the winch's length limits: beyond
+    winch.max_length the drum would hold a negative length of line (and negative mass)."""
+    L, w = p.tether.length, p.winch
+    if not w.min_length <= L <= w.max_length:
+        raise ParameterError(
+            f"tether.length = {L} m lies outside the winch's limits winch.min_length = "
+            f"{w.min_length} m .. winch.max_length = {w.max_length} m")
 
 
 def params_from_dict(data: dict) -> Params:
@@ -332,26 +346,72 @@ def apply_overrides(p: Params, overrides: dict[str, Any]) -> Params:
         if name not in data[sec]:
             raise ParameterError(f"unknown parameter {key!r}")
         data[sec][name] = list(value) if isinstance(value, tuple) else value
-    return params_from_dict(data)
+    new = params_from_dict(data)
+    prov = dict(p.provenance)
+    prov.update({key: USER for key in overrides})
+    return dataclasses.replace(new, provenance=tuple(sorted(prov.items())))
+
+
+BASELINE_NAME = "aeros_flightcam"
+
+
+def shipped_configs() -> tuple[str, ...]:
+    """Names of the parameter files shipped in aerostat_gym/data (loadable by name)."""
+    data = resources.files("aerostat_gym").joinpath("data")
+    return tuple(sorted(f.name[:-5] for f in data.iterdir() if f.name.endswith(".toml")))
+
+
+def _config_text(path: str | Path | None) -> tuple[str, str]:
+    """(TOML text, source name) of a path, a shipped configuration's name, or the baseline."""
+    if path is None:
+        path = BASELINE_NAME
+    if not Path(path).is_file() and str(path) in shipped_configs():
+        return resources.files("aerostat_gym").joinpath(f"data/{path}.toml").read_text(), str(path)
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(f"parameter file not found: {path} (shipped configurations: "
+                             f"{', '.join(shipped_configs())})")
+    return path.read_text(), str(path)
 
 
 def load_params(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Params:
-    """Load parameters from a TOML file (default: the shipped baseline) and apply overrides."""
-    if path is None:
-        text = resources.files("aerostat_gym").joinpath("data/aeros_flightcam.toml").read_text()
-        source = "baseline"
-    else:
-        path = Path(path)
-        if not path.is_file():
-            raise ParameterError(f"parameter file not found: {path}")
-        text = path.read_text()
-        source = str(path)
+    """Load parameters from a TOML file, or a shipped configuration by name (``"tcom_32m"``;
+    default: the baseline), and apply overrides."""
+    text, source = _config_text(path)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{source}: invalid TOML: {exc}") from exc
     p = params_from_dict(data)
+    p = dataclasses.replace(p, provenance=tuple(sorted(status_comments(text).items())))
     return apply_overrides(p, overrides) if overrides else p
+
+
+STATUSES = ("SOURCED", "DERIVED", "ESTIMATE", "CALIB", "USER")
+USER = "USER"
+
+
+def status_comments(text: str) -> dict[str, str]:
+    """The status word (SOURCED, DERIVED, ESTIMATE, CALIB or USER) of every ``key = value  #
+    ... STATUS ...`` line of a parameter TOML, as {"section.key": status}; fin panels are named
+    ``fins.panels[i].key``."""
+    out, section, panel = {}, "", -1
+    for line in text.splitlines():
+        body = line.split("#", 1)[0].strip()
+        if body.startswith("[[fins.panels]]"):
+            panel += 1
+            section = f"fins.panels[{panel}]"
+            continue
+        if body.startswith("["):
+            section = body.strip("[]").strip()
+            continue
+        if "=" not in body or "#" not in line:
+            continue
+        comment = line.split("#", 1)[1]
+        found = [w.strip("(),:;") for w in comment.split() if w.strip("(),:;") in STATUSES]
+        if found:
+            out[f"{section}.{body.split('=', 1)[0].strip()}"] = found[0]
+    return out
 
 
 def default_params(**overrides: Any) -> Params:
@@ -388,16 +448,51 @@ def dumps_toml(p: Params) -> str:
 
 
 def parameter_table(p: Params | None = None) -> list[dict]:
-    """Rows (name, value, unit, status, description) of every input, for reports and the CLI."""
+    """Rows (name, value, unit, status, description) of every input, for reports and the CLI.
+
+    The status follows the value: the status comment of the user's own file where it has one
+    (:attr:`Params.provenance`), USER for a value set by an override or one that differs from
+    the shipped baseline without a comment, and the baseline's status (dataclass metadata)
+    for a value equal to the baseline's.
+    """
     p = p or load_params()
+    base = _baseline_values()
+    prov = dict(p.provenance)
+    rows = _raw_rows(p)
+    for r in rows:
+        r["status"] = _status(r, prov, base)
+    return rows
+
+
+def _status(row: dict, provenance: dict, baseline: dict) -> str:
+    name = row["name"]
+    stated = provenance.get(name) or provenance.get(name.split(".panels[")[0] + ".panels")
+    if stated is not None:
+        return stated
+    return row["status"] if baseline.get(name) == row["value"] else USER
+
+
+def _baseline_values() -> dict:
+    """{name: value} of the shipped baseline (parsed once)."""
+    if not _BASELINE_VALUES:
+        text, _ = _config_text(BASELINE_NAME)
+        base = params_from_dict(tomllib.loads(text))
+        _BASELINE_VALUES.update({r["name"]: r["value"] for r in _raw_rows(base)})
+    return _BASELINE_VALUES
+
+
+_BASELINE_VALUES: dict = {}
+
+
+def _raw_rows(p: Params) -> list[dict]:
     rows = []
     for sec in SECTIONS:
         obj = getattr(p, sec)
         for f in fields(obj):
             if f.name == "panels":
                 for i, pan in enumerate(obj.panels):
-                    for g in fields(pan):
-                        rows.append(_row(f"fins.panels[{i}].{g.name}", getattr(pan, g.name), g))
+                    rows.extend(_row(f"fins.panels[{i}].{g.name}", getattr(pan, g.name), g)
+                                for g in fields(pan))
             else:
                 rows.append(_row(f"{sec}.{f.name}", getattr(obj, f.name), f))
     return rows

@@ -107,10 +107,10 @@ def test_unknown_key_missing_key_missing_section(base):
 
 def test_user_file_and_overrides(tmp_path, base):
     f = tmp_path / "mine.toml"
-    f.write_text(dumps_toml(base).replace("length = 300.0", "length = 450.0"))
+    f.write_text(dumps_toml(base).replace("length = 300.0", "length = 350.0"))
     p = load_params(f, overrides={"tether.n_elements": 20})
-    assert p.tether.length == 450.0 and p.tether.n_elements == 20
-    assert p.derived.element_length == pytest.approx(22.5)
+    assert p.tether.length == 350.0 and p.tether.n_elements == 20
+    assert p.derived.element_length == pytest.approx(17.5)
     with pytest.raises(ParameterError, match="not found"):
         load_params(tmp_path / "absent.toml")
     bad = tmp_path / "bad.toml"

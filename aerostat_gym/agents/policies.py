@@ -18,8 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.reference import reference_periods
 from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION
-from ..params import load_params
+from ..params import Params, load_params
 from ..resources import SHIPPED_POLICY, shipped_path
 from .lqr import LQRPolicy
 from .sb3io import PolicyError, as_batch, load_sb3, to_actions
@@ -27,6 +28,11 @@ from .sb3io import PolicyError, as_batch, load_sb3, to_actions
 BASELINES = ("passive", "tension", "lqr")
 #: Names of trained policies that ship with the package.
 SHIPPED = {"shipped": SHIPPED_POLICY}
+#: Tension feedback in units of the configuration: reel speed per tension excess, as a fraction
+#: of winch.max_speed per net lift (the baseline's 0.3 m/s per kN x 2.645 kN / 1 m/s), and the
+#: length-restoring time in longitudinal pendulum periods (the baseline's 60 s / 43.64 s).
+GAIN_PER_NET_LIFT = 0.3 * 2.6447
+RESTORE_PENDULUM_PERIODS = 60.0 / 43.64
 
 
 class PassivePolicy:
@@ -56,6 +62,24 @@ class TensionFeedbackPolicy:
             raise ValueError("tension feedback needs gain >= 0, restore_time > 0, max_speed > 0")
         self.gain, self.restore_time, self.max_speed = gain, restore_time, max_speed
 
+    @classmethod
+    def for_params(cls, params: Params) -> TensionFeedbackPolicy:
+        """The tension feedback designed for the configured aerostat and winch.
+
+        Notes
+        -----
+        The baseline's gains (0.3 m/s per kN, 60 s, 1 m/s) in the configuration's own units: a
+        tension excess of one net lift B - m g asks for GAIN_PER_NET_LIFT times the winch's
+        speed limit, and the length restores over RESTORE_PENDULUM_PERIODS of the
+        longitudinal pendulum's closed-form period; the speed limit is winch.max_speed. For
+        the baseline (2645 N, 43.6 s, 1 m/s) this gives 0.30 m/s per kN and 60 s again.
+        """
+        d = params.derived
+        v_max = float(params.winch.max_speed)
+        gain = GAIN_PER_NET_LIFT * v_max / (d.net_lift / 1.0e3)
+        restore = RESTORE_PENDULUM_PERIODS * reference_periods(params)["long_pendulum"]
+        return cls(gain=gain, restore_time=restore, max_speed=v_max)
+
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs, single = as_batch(observation)
         dT_kN = obs[:, OBS_DTENSION] * CHANNELS[OBS_DTENSION].scale / 1.0e3
@@ -64,15 +88,17 @@ class TensionFeedbackPolicy:
         return to_actions(v / self.max_speed, single), state
 
 
-def load_policy(name: str, params=None, dt: float = 0.2):
-    """A baseline by name ('passive', 'tension', 'lqr'), a shipped trained policy by name
-    ('shipped': the package's default PPO policy) or a saved SB3 model (path to .zip)."""
+def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None):
+    """A baseline by name ('passive', 'tension', 'lqr') designed for ``params`` (default: the
+    baseline) and the wind range (for the LQR schedule), a shipped trained policy by name
+    ('shipped': the package's default PPO policy) or a saved SB3 model (.zip path)."""
+    params = params or load_params()
     if name == "passive":
         return PassivePolicy()
     if name == "tension":
-        return TensionFeedbackPolicy()
+        return TensionFeedbackPolicy.for_params(params)
     if name == "lqr":
-        return LQRPolicy(params or load_params(), dt=dt)
+        return LQRPolicy(params, dt=dt, wind_range=wind_range)
     if name in SHIPPED:
         return load_sb3(shipped_path(SHIPPED[name]))
     if name.endswith(".zip") or Path(name).exists():

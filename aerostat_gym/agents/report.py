@@ -167,6 +167,9 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
     if plots:
         for p in plot(results, out):
             parts += [f"![{p.stem}]({p.name})", ""]
+    if "params_toml" in results[0]:
+        (out / "params.toml").write_text(results[0]["params_toml"])
+        parts += [f"Parameters: `params.toml` (tether {results[0]['tether_length_m']:g} m).", ""]
     md = out / "report.md"
     md.write_text("\n".join(parts))
     (out / "report.json").write_text(json.dumps(jsonable(results), indent=1))
@@ -182,10 +185,12 @@ def jsonable(results: list[dict]) -> list[dict]:
     return out
 
 
-def run_evaluations(policies: list[str], suite: str, progress: bool = True) -> list[dict]:
+def run_evaluations(policies: list[str], suite: str, progress: bool = True,
+                    params=None) -> list[dict]:
+    """Evaluate every policy on ``suite`` in the environment of ``params`` (default baseline)."""
     results = []
     for name in _progress(policies, progress, "evaluating"):
-        r = evaluate_policy(name, suite)
+        r = evaluate_policy(name, suite, params=params)
         r["label"] = Path(name).stem if name.endswith(".zip") else (
             Path(SHIPPED_POLICY).stem if name == "shipped" else name)
         results.append(r)

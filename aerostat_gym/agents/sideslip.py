@@ -17,9 +17,10 @@ OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 80, 100)
 WIND = [OBS_WIND_X, OBS_WIND_Y, OBS_WIND_Z]  # measured air velocity at the CM
 
 
-def yaw_curve(stall_deg: float, wind_speed: float = 8.0) -> list[float]:
-    """Yaw acceleration dr/dt [rad/s^2] at the trim with psi offset by each of OFFSETS_DEG."""
-    p = load_params().replace(**{"fins.alpha_stall_deg": stall_deg})
+def yaw_curve(stall_deg: float, wind_speed: float = 8.0, params=None) -> list[float]:
+    """Yaw acceleration dr/dt [rad/s^2] at the trim with psi offset by each of OFFSETS_DEG, for
+    ``params`` (default: the baseline) with the fin stall angle set."""
+    p = (params or load_params()).replace(**{"fins.alpha_stall_deg": stall_deg})
     eq = find_equilibrium(p, wind_speed)
     model = Model(p, wind=wind_speed)
     lay = model.layout
@@ -38,10 +39,11 @@ def sideslip(euler: np.ndarray, v_rel: np.ndarray) -> np.ndarray:
     return np.degrees(np.arctan2(np.abs(body[:, 1]), body[:, 0]))
 
 
-def max_sideslip(turbulence: str, wind_speed: float, episodes: int) -> np.ndarray:
-    """Largest sideslip [deg] of each passive-winch episode (120 s, seeds 100, 101, ...)."""
+def max_sideslip(turbulence: str, wind_speed: float, episodes: int, params=None) -> np.ndarray:
+    """Largest sideslip [deg] of each passive-winch episode (120 s, seeds 100, 101, ...) in the
+    environment of ``params`` (default: the baseline)."""
     env = TetheredAerostatVectorEnv(num_envs=episodes, max_episode_steps=600, observation="full",
-                                    turbulence=turbulence, perturbation="none")
+                                    turbulence=turbulence, perturbation="none", params=params)
     obs, _ = env.reset(seed=list(range(100, 100 + episodes)),
                        options={"wind_speed": [wind_speed] * episodes})
     b, lay = env.batch, env.batch.layout

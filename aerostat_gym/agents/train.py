@@ -115,8 +115,10 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
           eval_freq: int | None = None, params=None) -> Path:
     """Train and return the run directory (see the module docstring).
 
-    ``hyperparams`` is the YAML file (default: the shipped one for ``algo``); ``params`` a
-    physics parameter set or TOML path for the environment (default: the baseline).
+    ``hyperparams`` is the YAML file (default: the shipped one for ``algo``); ``params`` the
+    physics configuration (a Params, a TOML path or a shipped name; default the baseline), used
+    by the training environments and the suite evaluations and written to ``params.toml`` in
+    the run directory.
     """
     import torch
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
@@ -141,7 +143,8 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     callbacks = CallbackList([
         CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"), name_prefix=algo,
                            save_vecnormalize=True),
-        suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1), run),
+        suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1), run,
+                            env_kwargs.get("params")),
     ])
     t0 = time.perf_counter()
     model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress_bar,
@@ -158,7 +161,7 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     return run
 
 
-def suite_eval_callback(suite: str, freq: int, run: Path):
+def suite_eval_callback(suite: str, freq: int, run: Path, params=None):
     """A callback that, every ``freq`` calls, scores the current policy on the fixed suite
     (deterministic actions, the training VecNormalize statistics), logs it, appends it to
     ``evaluations.json`` and saves the best-scoring model (with its statistics) as
@@ -182,7 +185,8 @@ def suite_eval_callback(suite: str, freq: int, run: Path):
                 self.evaluate_now()
 
         def evaluate_now(self) -> None:
-            score = suite_score(SB3Policy(self.model, self.model.get_env()), suite)
+            score = suite_score(SB3Policy(self.model, self.model.get_env()), suite,
+                                params=params)
             self.logger.record("eval/suite_score", score)
             self.history.append({"timesteps": int(self.num_timesteps), "score": score,
                                  "wall_time_s": time.perf_counter() - self.t0})

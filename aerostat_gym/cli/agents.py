@@ -14,6 +14,7 @@ from ..analysis.modes import analyse
 from ..analysis.trim import find_equilibrium
 from ..params import load_params
 from ..registration import TASKS
+from .common import add_config, config_label, params_from_args
 
 
 def add_train_parser(sub) -> None:
@@ -23,8 +24,6 @@ def add_train_parser(sub) -> None:
     p.add_argument("--algo", choices=ALGOS, default="ppo", help="Stable-Baselines3 algorithm")
     p.add_argument("--hyperparams", metavar="YAML",
                    help="rl-zoo3 hyperparameter file (default: the shipped hyperparams/ALGO.yml)")
-    p.add_argument("--config", metavar="TOML",
-                   help="physics parameter file of the environment (default: the baseline)")
     p.add_argument("--timesteps", type=int, help="total environment steps (default: the YAML's)")
     p.add_argument("--n-envs", type=int, help="parallel environments (default: the YAML's)")
     p.add_argument("--seed", type=int, default=0, help="training seed")
@@ -34,13 +33,14 @@ def add_train_parser(sub) -> None:
                    help="environment steps between suite evaluations (default: the YAML's)")
     p.add_argument("--threads", type=int, help="torch threads (default: torch's own)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_config(p, json=False)
     p.set_defaults(func=_train_command)
 
 
 def _train_command(args) -> int:
     if args.timesteps is not None and args.timesteps < 1:
         raise ValueError(f"--timesteps must be >= 1, got {args.timesteps}")
-    params = load_params(args.config) if args.config else None
+    params = params_from_args(args) if (args.config or args.set) else None
     run = train(args.algo, args.hyperparams, args.timesteps, args.n_envs, args.seed,
                 args.run_dir, args.resume, not args.no_progress, args.threads, args.eval_freq,
                 params=params)
@@ -58,11 +58,13 @@ def add_evaluate_parser(sub) -> None:
     p.add_argument("--out", default="runs/evaluate", help="report directory")
     p.add_argument("--json", action="store_true", help="print the metrics as JSON")
     p.add_argument("--no-plots", action="store_true", help="write no PNG plots")
+    add_config(p, json=False)
     p.set_defaults(func=_evaluate_command)
 
 
 def _evaluate_command(args) -> int:
-    results = run_evaluations(args.policy, args.suite, progress=not args.json)
+    results = run_evaluations(args.policy, args.suite, progress=not args.json,
+                              params=params_from_args(args))
     md = write_report(results, args.out, f"Evaluation on suite `{args.suite}`",
                       "aerostat-gym " + " ".join(sys.argv[1:]), plots=not args.no_plots)
     if args.json:
@@ -81,16 +83,23 @@ def add_demo_parser(sub) -> None:
     p.add_argument("--policy", default="shipped",
                    help="policy to compare with the baselines: shipped or PATH.zip")
     p.add_argument("--out", default="runs/demo", help="report directory")
+    p.add_argument("--suite", choices=list(SUITES), default="tiny", help="evaluation suite")
+    add_config(p, json=False)
     p.set_defaults(func=_demo_command)
 
 
 def _demo_command(args) -> int:
     t0 = time.perf_counter()
     load_policy(args.policy)  # a missing or corrupt policy is refused before any work
-    summary = demo_summary(load_params(), args.wind)
+    params = params_from_args(args)
+    policies = ["passive", "lqr"]
+    if params == load_params() or args.policy != "shipped":
+        policies.append(args.policy)  # the shipped policy was trained on the baseline
+    summary = demo_summary(params, args.wind, config_label(args))
     print("\n".join(summary))
-    results = run_evaluations(["passive", "lqr", args.policy], "tiny")
-    md = write_report(results, args.out, "aerostat-gym demo", "aerostat-gym demo",
+    results = run_evaluations(policies, args.suite, params=params)
+    md = write_report(results, args.out, "aerostat-gym demo",
+                      "aerostat-gym demo " + " ".join(sys.argv[1:]),
                       preamble=["## Trim and linear stability", "", "```", *summary, "```", ""])
     print()
     print(comparison_table(results, "recover"))
@@ -98,23 +107,22 @@ def _demo_command(args) -> int:
     return 0
 
 
-def demo_summary(params, wind: float) -> list[str]:
+def demo_summary(params, wind: float, label: str = "baseline") -> list[str]:
     """The demo's trim and linear-stability summary, as lines of text."""
     eq = find_equilibrium(params, wind)
     s = eq.summary
     x, _, z = s["aerostat_position_m"]
-    lines = [f"aerostat-gym demo: baseline aerostat, L = {params.tether.length:g} m, "
-             f"U = {wind:g} m/s",
+    lines = [f"aerostat-gym demo: {label}, L = {params.tether.length:g} m, U = {wind:g} m/s",
              f"  trim: CM x = {x:.1f} m, z = {z:.1f} m, blow-by {s['blow_by_deg']:.2f} deg, "
              f"pitch {s['pitch_deg']:.2f} deg, winch tension {s['winch_tension_N'] / 1e3:.2f} kN"]
     ana = analyse(params, eq)
     lines.append(f"  linear stability: all modes stable = {ana.all_stable()}")
-    for subset, label in (("long", "pendulum"), ("long", "pitching"), ("long", "axial spring"),
-                          ("lat", "pendulum"), ("lat", "rolling")):
-        m = ana.find(subset, label)
+    for subset, label_ in (("long", "pendulum"), ("long", "pitching"), ("long", "axial spring"),
+                           ("lat", "pendulum"), ("lat", "rolling")):
+        m = ana.find(subset, label_)
         if m is not None:
             name = {"long": "longitudinal", "lat": "lateral"}[subset]
-            lines.append(f"    {name:12s} {label:13s} period {m.period:7.2f} s  "
+            lines.append(f"    {name:12s} {label_:13s} period {m.period:7.2f} s  "
                          f"damping {m.zeta:.3f}")
     return lines
 

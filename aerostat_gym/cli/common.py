@@ -8,15 +8,24 @@ from __future__ import annotations
 
 import argparse
 
-from ..params import ParameterError, load_params, tomllib
+from ..params import ParameterError, load_params, shipped_configs, tomllib
 
 
-def add_config(p: argparse.ArgumentParser) -> None:
-    """``--config``, ``--set`` and ``--json`` on a command's parser."""
-    p.add_argument("--config", help="parameter TOML file (default: the shipped baseline)")
+def add_config(p: argparse.ArgumentParser, json: bool = True) -> None:
+    """``--config``, ``--set`` and (unless ``json=False``) ``--json`` on a command's parser."""
+    p.add_argument("--config", help="parameter TOML file or a shipped configuration's name "
+                   f"({', '.join(shipped_configs())}; default: the baseline)")
     p.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override one parameter, e.g. --set tether.length=150 (repeatable)")
-    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    if json:
+        p.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+
+def config_label(args) -> str:
+    """How the configuration was given, for headers: the file or name, plus the overrides."""
+    label = getattr(args, "config", None) or "baseline"
+    sets = getattr(args, "set", None) or []
+    return label + "".join(f" --set {s}" for s in sets)
 
 
 def parse_overrides(items: list[str]) -> dict:

@@ -14,7 +14,8 @@ import numpy as np
 
 from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
 from ..wind.field import build_wind, field_heights, field_times
-from ..wind.presets import METHODS, PRESETS, get_preset
+from ..wind.presets import METHODS, PRESETS
+from ..wind.sizing import FROM_CONFIG, sized_turbulence
 from ..wind.spectra import MODELS
 from ..wind.stats import (
     COMPONENTS,
@@ -26,6 +27,7 @@ from ..wind.stats import (
     target_psd,
     welch_psd,
 )
+from .common import add_config, params_from_args
 
 
 def add_wind_parser(subparsers) -> argparse.ArgumentParser:
@@ -35,26 +37,32 @@ def add_wind_parser(subparsers) -> argparse.ArgumentParser:
         description="Generate the turbulence field of one episode and print its realised "
         "statistics (sigma, integral length scale, coherence between heights) next to their "
         "targets. One 600 s record gives rough values; pool seeds with --ensemble.")
-    p.add_argument("--preset", default="moderate", help=f"one of {list(PRESETS)}")
+    p.add_argument("--preset", default=None, help=f"one of {list(PRESETS)} or '{FROM_CONFIG}' "
+                   "(the parameter file's wind.turbulence; default: moderate, or the file's "
+                   "preset with --config)")
     p.add_argument("--seed", type=int, default=0, help="seed of numpy.random.default_rng")
     p.add_argument("--duration", type=float, default=600.0, help="episode length [s]")
     p.add_argument("--speed", type=float, default=8.0, help="mean speed at the reference height [m/s]")
-    p.add_argument("--profile", default="uniform", choices=sorted(PROFILES), help="mean profile")
-    p.add_argument("--reference-height", type=float, default=10.0,
-                   help="reference height of the power/log profile [m]")
+    p.add_argument("--profile", default=None, choices=sorted(PROFILES),
+                   help="mean profile (default: the configuration's wind.profile)")
+    p.add_argument("--reference-height", type=float, default=None,
+                   help="reference height of the power/log profile [m] (default: the configuration's)")
     p.add_argument("--model", choices=MODELS, help="override the preset's spectrum")
     p.add_argument("--method", choices=METHODS, help="override the generation method")
-    p.add_argument("--height", type=float, help="aerostat nominal height (field advection) [m]")
+    p.add_argument("--height", type=float, help="aerostat nominal height (field advection) [m] "
+                   "(default: the configuration's wind.turbulence_reference_height)")
     p.add_argument("--ensemble", type=int, default=1, help="pool this many seeds from --seed on")
     p.add_argument("--plot", metavar="FILE", help="write a PNG (time series, PSD, coherence)")
-    p.add_argument("--json", action="store_true", help="print the statistics as JSON")
+    add_config(p)
     p.set_defaults(func=wind_command)
     return p
 
 
-def _config(args):
-    """Preset with the command-line overrides (errors are ValueError with a clear message)."""
-    cfg = get_preset(args.preset)
+def _config(args, params):
+    """Preset with the command-line overrides, its field grid sized from the configuration
+    (errors are ValueError with a clear message)."""
+    preset = args.preset or (FROM_CONFIG if args.config else "moderate")
+    cfg = sized_turbulence(params, preset)
     changes = {k: v for k, v in (("model", args.model), ("method", args.method),
                                  ("reference_height", args.height)) if v is not None}
     if changes.get("method") == "filter" and "model" not in changes:
@@ -65,11 +73,14 @@ def _config(args):
 def wind_command(args) -> int:
     """Run ``aerostat-gym wind``; returns the exit status (2 on invalid input)."""
     try:
-        cfg = _config(args)
+        params = params_from_args(args)
+        cfg = _config(args, params)
         if args.ensemble < 1:
             raise ValueError(f"--ensemble must be >= 1, got {args.ensemble}")
-        mean = {"profile": args.profile, "speed": args.speed,
-                "reference_height": args.reference_height}
+        w = params.wind
+        mean = {"profile": args.profile or w.profile, "speed": args.speed,
+                "reference_height": args.reference_height or w.reference_height,
+                "shear_exponent": w.shear_exponent, "roughness_length": w.roughness_length}
         build_wind(mean, cfg, 1.0, np.random.default_rng(0))  # load the compiled kernels
         t0 = time.perf_counter()
         wp, wf = build_wind(mean, cfg, args.duration, np.random.default_rng(args.seed))
@@ -79,7 +90,7 @@ def wind_command(args) -> int:
     except (ValueError, TypeError) as e:
         print(f"aerostat-gym wind: error: {e}")
         return 2
-    out = {"preset": args.preset, "model": cfg.model, "method": cfg.method, "seed": args.seed,
+    out = {"preset": args.preset or (FROM_CONFIG if args.config else "moderate"), "model": cfg.model, "method": cfg.method, "seed": args.seed,
            "duration_s": args.duration, "mean_speed": args.speed,
            "field_shape": list(wf.shape), "generation_s": gen_s}
     if not cfg.is_off:

@@ -116,8 +116,13 @@ class TetheredAerostatEnv(gym.Env):
     ``gym.make("TetheredAerostat-v0", **kwargs)`` with:
 
     - ``wind_speed=(3.0, 15.0)``: range of the episode's mean wind speed [m/s].
-    - ``turbulence="moderate"``: preset ("none", "light", "moderate", "severe") or a dict of
-      :class:`aerostat_gym.wind.TurbulenceConfig` fields (key "preset" picks the base).
+    - ``turbulence="moderate"``: preset ("none", "light", "moderate", "severe"), "config" (the
+      parameter file's ``wind.turbulence`` and ``wind.turbulence_model``), or a dict of
+      :class:`aerostat_gym.wind.TurbulenceConfig` fields (key "preset" picks the base). The
+      field's heights run from the winch to above the highest point the aerostat reaches at
+      ``winch.max_length`` and its extent follows the longest tether
+      (:func:`aerostat_gym.wind.sizing.field_extent`); ``wind.turbulence_reference_height``
+      sets the advection height.
     - ``perturbation="mixed"``: "none", "displacement", "gust", "mixed" or a dict with keys
       swing [m], lateral [m], pitch [rad], gust_probability, gust_amplitude [m/s] (low, high),
       gust_duration [s] (low, high), gust_onset [s] (low, high).
