@@ -3,7 +3,8 @@
 Commands: ``trim`` (equilibrium summary), ``params`` (every parameter with its unit and status),
 ``bench`` (speed and accuracy figures), ``wind`` (turbulence statistics), ``stability``,
 ``table2`` and ``sensitivity`` (linear stability analysis), ``train``, ``evaluate`` and ``demo``
-(winch-control agents). Errors in user input print one clear line and exit with status 2.
+(winch-control agents), ``tune`` and ``montecarlo`` (Ray, the optional extra). Errors in user
+input print one clear line and exit with status 2.
 """
 
 from __future__ import annotations
@@ -102,6 +103,10 @@ def build_parser() -> argparse.ArgumentParser:
     from .agents.cli import add_agent_parsers
 
     add_agent_parsers(sub)
+    from .scale.cli import add_montecarlo_parser, add_tune_parser
+
+    add_tune_parser(sub)
+    add_montecarlo_parser(sub)
     return ap
 
 

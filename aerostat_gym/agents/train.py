@@ -79,8 +79,10 @@ def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize):
 def train(algo: str, config: str | Path | None = None, timesteps: int | None = None,
           n_envs: int | None = None, seed: int = 0, run_dir: str | Path | None = None,
           resume: str | Path | None = None, progress_bar: bool = True, threads: int | None = None,
-          eval_freq: int | None = None) -> Path:
-    """Train and return the run directory (see the module docstring)."""
+          eval_freq: int | None = None, on_eval=None) -> Path:
+    """Train and return the run directory (see the module docstring). ``on_eval(record, run)``,
+    if given, is called after every suite evaluation (``record`` as in evaluations.json, plus
+    ``"best"``: whether best_model.zip was just saved)."""
     import torch
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
     from stable_baselines3.common.utils import set_random_seed
@@ -101,7 +103,7 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     callbacks = CallbackList([
         CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"), name_prefix=algo,
                            save_vecnormalize=True),
-        suite_eval_callback(hp.get("eval_suite", "tiny"), max(freq // n_envs, 1), run),
+        suite_eval_callback(hp.get("eval_suite", "tiny"), max(freq // n_envs, 1), run, on_eval),
     ])
     t0 = time.perf_counter()
     model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress_bar,
@@ -117,7 +119,7 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     return run
 
 
-def suite_eval_callback(suite: str, freq: int, run: Path):
+def suite_eval_callback(suite: str, freq: int, run: Path, on_eval=None):
     """A callback that, every ``freq`` calls, scores the current policy on the fixed suite
     (deterministic actions, the training VecNormalize statistics), logs it, appends it to
     ``evaluations.json`` and saves the best-scoring model (with its statistics) as
@@ -149,9 +151,12 @@ def suite_eval_callback(suite: str, freq: int, run: Path):
             self.history.append({"timesteps": int(self.num_timesteps), "score": score,
                                  "wall_time_s": time.perf_counter() - self.t0})
             (Path(run) / "evaluations.json").write_text(json.dumps(self.history, indent=1))
-            if score > self.best:
+            best = score > self.best
+            if best:
                 self.best = score
                 save_model(self.model, Path(run) / "best_model.zip")
+            if on_eval is not None:
+                on_eval({**self.history[-1], "best": best}, Path(run))
 
     return SuiteEvalCallback()
 
