@@ -140,23 +140,27 @@ def format_summary(s: dict) -> str:
         f"failed {s['n_errors']}",
     ]
     lines += _probability_lines(s)
-    lines.append("Table 2 periods at 1 m/s [s]: median [5 %, 95 %]")
+    lines.append("Table 2 periods at 1 m/s [s]: median [5 %, 95 %] (sets where the mode "
+                 "oscillates)")
     for key in PERIOD_KEYS:
         d = s["periods_s"][key]
         if d["n"]:
-            lines.append(f"  {key:14s} {d['p50']:8.3f} [{d['p5']:.3f}, {d['p95']:.3f}]")
+            lines.append(f"  {key:14s} {d['p50']:8.3f} [{d['p5']:.3f}, {d['p95']:.3f}]  "
+                         f"n = {d['n']}")
     z = s["min_zeta"]
     if z["n"]:
         lines.append(f"smallest damping ratio: median {z['p50']:.4f} [5 %: {z['p5']:.4f}, "
-                     f"95 %: {z['p95']:.4f}]")
+                     f"95 %: {z['p95']:.4f}]; {z['divergences']} sets with a divergence "
+                     "(a real positive eigenvalue, zeta = -1)")
     lines.append("parameters vs instability: r (unstable somewhere), Spearman rho (max Re "
                  "lambda), unstable rate in the low / high fifth of the range")
     for r in s["correlations"]:
         lines.append(f"  {r['parameter']:26s} r {r['r_unstable']:+.3f}  rho {r['rho_max_real']:+.3f}"
                      f"  {_pct(r['unstable_rate_low_fifth'])} % / {_pct(r['unstable_rate_high_fifth'])} %")
     for m in s["mode_instabilities"]:
-        lines.append(f"  unstable {m['mode']}: {m['samples_unstable']} sets, at "
-                     f"{m['speeds_m_s']} m/s; follows {m['top_parameter']} (r {m['r']:+.2f})")
+        u = m["speeds_m_s"]
+        lines.append(f"  unstable {m['mode']}: {m['samples_unstable']} sets, at {len(u)} speeds in "
+                     f"{min(u):g}-{max(u):g} m/s; follows {m['top_parameter']} (r {m['r']:+.2f})")
     return "\n".join(lines)
 
 

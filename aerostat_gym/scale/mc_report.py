@@ -17,6 +17,8 @@ from .stats import point_biserial, spearman, wilson_interval
 PERCENTILES = (5, 25, 50, 75, 95)
 #: Share of a parameter's range at each end used for the conditional instability rates.
 TAIL = 0.2
+#: A damping ratio at or below this is a real positive eigenvalue (zeta = -1, a divergence).
+DIVERGENCE_ZETA = -0.999
 
 
 def complete_mask(study: Study) -> np.ndarray:
@@ -146,7 +148,8 @@ def summarize(study: Study, nominal=None) -> dict:
                               "fraction_of_complete": float(every[ok].mean()) if ok.any()
                               else math.nan},
         "periods_s": {key: distribution(periods[:, i]) for i, key in enumerate(PERIOD_KEYS)},
-        "min_zeta": distribution(min_zeta(study)),
+        "min_zeta": {**distribution(min_zeta(study)),
+                     "divergences": int(np.sum(min_zeta(study) <= DIVERGENCE_ZETA))},
         "stability": stability_table(study),
         "correlations": correlations(study),
         "mode_instabilities": mode_instability_drivers(study),
@@ -214,10 +217,7 @@ def plot_study(study: Study, summary: dict, path: Path) -> Path:
     fig, ax = plt.subplots(2, 2, figsize=(12, 8.5))
     _plot_probability(ax[0, 0], summary)
     _plot_periods(ax[0, 1], study)
-    zmin = min_zeta(study)
-    ax[1, 0].hist(zmin[np.isfinite(zmin)], bins=40, color="tab:blue")
-    ax[1, 0].set(xlabel="smallest damping ratio over the sweep", ylabel="parameter sets",
-                 title="smallest damping ratio (Figure 9 modes + yaw)")
+    _plot_min_zeta(ax[1, 0], min_zeta(study))
     _plot_correlations(ax[1, 1], summary)
     frac = summary["stable_everywhere"]
     fig.suptitle(f"Monte Carlo, {summary['samples']} parameter sets (seed {summary['seed']}): "
@@ -250,6 +250,16 @@ def _plot_periods(a, study: Study) -> None:
                    f"{np.median(x):.3g} s)")
     a.set(xlabel="period / median", ylabel="parameter sets", title="Table 2 periods at 1 m/s")
     a.legend(fontsize=7)
+
+
+def _plot_min_zeta(a, zmin: np.ndarray) -> None:
+    z = zmin[np.isfinite(zmin)]
+    divergent = int(np.sum(z <= DIVERGENCE_ZETA))
+    a.hist(z[z > DIVERGENCE_ZETA], bins=50, color="tab:blue")
+    a.axvline(0.0, color="k", lw=0.8)
+    a.set(xlabel="smallest damping ratio over the sweep", ylabel="parameter sets",
+          title=f"smallest damping ratio ({divergent} sets with a divergence, zeta = -1, "
+          "not shown)")
 
 
 def _plot_correlations(a, summary: dict) -> None:

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..analysis.modes import FIGURE9_MODES, SETS, ModalAnalysis, analyse
-from ..analysis.reference import TABLE2, linear_table2_periods
+from ..analysis.reference import TABLE2, TABLE2_MODES
 from ..analysis.trim import TrimError, find_equilibrium
 from ..params import ParameterError, Params
 from .cluster import start_ray, stop_ray
@@ -49,7 +49,8 @@ class SampleResult:
     period : (speed, mode) period [s] (inf for a real eigenvalue).
     all_stable : (speed,) every mode of the linear model stable (1.0 / 0.0 / nan).
     max_real : (speed,) largest Re(lambda) of a non-neutral mode [1/s].
-    periods : the Table 2 periods at :data:`PERIOD_SPEED` [s], in :data:`PERIOD_KEYS` order.
+    periods : the Table 2 periods at :data:`PERIOD_SPEED` [s], in :data:`PERIOD_KEYS` order
+        (nan for a mode that is not oscillatory there).
     error : empty, or why the sample stopped (a failed trim, an impossible parameter set).
     """
 
@@ -150,6 +151,16 @@ def _record(res: SampleResult, k: int, an: ModalAnalysis) -> None:
     res.max_real[k] = max(m.eigenvalue.real for m in an.long + an.lat if not m.neutral)
 
 
+def table2_periods(an: ModalAnalysis) -> list[float]:
+    """Periods [s] of the Table 2 modes, nan where the mode is missing or not oscillatory (a
+    real eigenvalue has no period: 2 pi / |lambda| of a divergence is not one)."""
+    out = []
+    for key in PERIOD_KEYS:
+        m = an.find(*TABLE2_MODES[key])
+        out.append(m.period if m is not None and m.oscillatory else math.nan)
+    return out
+
+
 def evaluate_sample(base: Params, ranges: list[ParameterRange], values: np.ndarray,
                     speeds: np.ndarray) -> SampleResult:
     """Trim and linearize one parameter set at every speed (the one per-sample function).
@@ -177,8 +188,7 @@ def evaluate_sample(base: Params, ranges: list[ParameterRange], values: np.ndarr
             eq = find_equilibrium(params, u, guess=eq)
             an = analyse(params, eq)
             if u == PERIOD_SPEED:
-                periods = linear_table2_periods(an)
-                res.periods[:] = [periods[key] for key in PERIOD_KEYS]
+                res.periods[:] = table2_periods(an)
             hit = np.flatnonzero(speeds == u)
             if hit.size:
                 _record(res, int(hit[0]), an)

@@ -469,6 +469,7 @@ def run_tune_command(args: argparse.Namespace) -> int:
     """``aerostat-gym tune``: run the search and print the per-configuration table."""
     require("ray.tune", "aerostat-gym tune")
     require("optuna", "aerostat-gym tune")
+    require("stable_baselines3", "aerostat-gym tune", extra="train")
     setup = setup_from_args(args)
     opts = SearchOptions(args.configs, args.searcher, args.scheduler, args.search_seed,
                          args.cpus_per_trial, args.address, args.workers)
