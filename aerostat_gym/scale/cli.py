@@ -70,6 +70,8 @@ def add_montecarlo_parser(sub) -> None:
     p.add_argument("--no-plot", action="store_true", help="skip the figure")
     p.add_argument("--bench", action="store_true", help="measure serial vs Ray throughput "
                    "and Ray start-up on --samples sets, print them, write nothing else")
+    p.add_argument("--repeats", type=int, default=3, help="--bench: alternated serial and "
+                   "Ray runs (default 3)")
     p.set_defaults(func=montecarlo_command)
 
 
@@ -102,7 +104,7 @@ def montecarlo_command(args: argparse.Namespace) -> int:
     speeds = _speeds(args.wind)
     if args.bench:
         res = throughput(base, ranges, args.samples, args.seed, speeds, args.workers or 2,
-                         args.batch_size)
+                         args.batch_size, args.repeats)
         print(json.dumps(res, indent=2) if args.json else format_throughput(res))
         return 0
     if args.serial:
