@@ -16,29 +16,14 @@ from pathlib import Path
 
 import numpy as np
 
+# the stability commands' parsing of --wind, --config and --set, shared rather than copied
+from ..analysis.stability_cli import _params as params_from_args
 from ..analysis.stability_cli import parse_speeds
-from ..params import load_params
 from .bench import format_throughput, throughput
 from .mc_report import summarize, write_outputs
 from .montecarlo import PERIOD_KEYS, SWEEP_SPEEDS, evaluate_sample, run_ray, run_serial
 from .ranges import RANGE_SOURCES, estimated_ranges
 from .tune import add_tune_arguments, run_tune_command
-
-
-def _set_overrides(items: list[str]) -> dict:
-    """``--set SECTION.KEY=VALUE`` items; values parsed as TOML (bare words as strings)."""
-    import tomllib
-
-    out = {}
-    for item in items:
-        if "=" not in item:
-            raise ValueError(f"--set expects SECTION.KEY=VALUE, got {item!r}")
-        key, raw = item.split("=", 1)
-        try:
-            out[key.strip()] = tomllib.loads(f"v = {raw}")["v"]
-        except tomllib.TOMLDecodeError:
-            out[key.strip()] = raw
-    return out
 
 
 def add_montecarlo_parser(sub) -> None:
@@ -99,7 +84,7 @@ def _progress(done: int, n: int) -> None:
 
 def montecarlo_command(args: argparse.Namespace) -> int:
     """Run the study (or its throughput benchmark) and print the summary."""
-    base = load_params(args.config, _set_overrides(args.set) or None)
+    base = params_from_args(args)
     ranges = estimated_ranges(base, args.ranges)
     speeds = _speeds(args.wind)
     if args.bench:

@@ -172,10 +172,15 @@ class TrialSetup:
 
     Attributes
     ----------
-    algo : ppo, sac or td3. base : base hyperparameter block. space : the search space.
-    decode : JSON-coded choice keys. seeds : training seeds (one trial each per configuration).
-    timesteps : environment steps per trial. n_envs : environments (None: the YAML's).
-    eval_freq : steps between suite evaluations. threads : torch / numba threads per trial.
+    algo : ppo, sac or td3.
+    base : base hyperparameter block.
+    space : the search space.
+    decode : JSON-coded choice keys.
+    seeds : training seeds (one trial each per configuration).
+    timesteps : environment steps per trial.
+    n_envs : environments per trial (None: the YAML's).
+    eval_freq : steps between suite evaluations.
+    threads : torch / numba threads per trial.
     """
 
     algo: str
@@ -271,9 +276,12 @@ class SearchOptions:
 
     Attributes
     ----------
-    configs : configurations to try (each trained once per seed). searcher : optuna or
-    random. scheduler : fifo or asha. search_seed : seed of the sampler.
-    cpus_per_trial : CPUs reserved per trial. address : cluster (None: local).
+    configs : configurations to try (each trained once per seed).
+    searcher : optuna (TPE) or random.
+    scheduler : fifo or asha.
+    search_seed : seed of the sampler.
+    cpus_per_trial : CPUs reserved per trial.
+    address : cluster to join (None: a local instance).
     workers : CPUs of the local instance (None: the machine's).
     """
 
