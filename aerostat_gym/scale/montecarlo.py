@@ -70,10 +70,14 @@ class Study:
 
     Attributes
     ----------
-    keys : names of the uncertain parameters. ranges : (low, high) of each.
-    nominal : baseline value of each. speeds : wind speeds of the sweep [m/s].
-    seed : the sampling seed. samples : one :class:`SampleResult` per parameter set.
-    backend : "serial" or "ray". seconds : wall time of the evaluation (after Ray start-up).
+    keys : names of the uncertain parameters.
+    ranges : (low, high) of each.
+    nominal : baseline value of each.
+    speeds : wind speeds of the sweep [m/s].
+    seed : the sampling seed.
+    samples : one :class:`SampleResult` per parameter set.
+    backend : "serial" or "ray".
+    seconds : wall time of the evaluation (after Ray start-up).
     meta : Ray start-up figures, workers, batch size.
     """
 

@@ -194,6 +194,23 @@ class TrialSetup:
     threads: int
 
 
+def trial_hyperparams(setup: TrialSetup, sample: dict, decode=()) -> dict:
+    """The hyperparameter block one trial trains with: the base, the space's fixed and sampled
+    values, and the trial's step budget (and environment count, if set on the command line).
+
+    Parameters
+    ----------
+    setup : what every trial shares.
+    sample : sampled values by key.
+    decode : keys whose sampled value is JSON text.
+    """
+    hp = apply_sample(setup.base, setup.space, sample, decode)
+    hp["n_timesteps"] = setup.timesteps
+    if setup.n_envs:
+        hp["n_envs"] = setup.n_envs
+    return hp
+
+
 def _pin_threads(threads: int) -> None:
     """One BLAS / torch / numba thread pool of the trial's size (no oversubscription when
     several trials share a node)."""
@@ -214,7 +231,7 @@ def run_trial(config: dict, setup: TrialSetup) -> None:
     from ray import tune
 
     seed = int(setup.seeds[int(config.get(SEED_INDEX, 0))])
-    hp = apply_sample(setup.base, setup.space, config, setup.decode)
+    hp = trial_hyperparams(setup, config, setup.decode)
     trial_dir = Path(tune.get_context().get_trial_dir())
     trial_dir.mkdir(parents=True, exist_ok=True)
     cfg_path = trial_dir / "hyperparams_trial.yml"
@@ -314,7 +331,10 @@ def run_search(setup: TrialSetup, opts: SearchOptions, out: Path,
                          f"{list(setup.seeds)}")
     start = start_ray(command, opts.address, opts.workers)
     try:
-        results = _fit(setup, opts, out.resolve())
+        tune = require("ray.tune", command)
+        space, decode = tune_space(setup.space, tune)
+        setup = TrialSetup(**{**setup.__dict__, "decode": frozenset(decode)})
+        results = _fit(setup, opts, space, out.resolve())
     finally:
         stop_ray(start)
     trials = [_trial_row(r, setup) for r in results]
@@ -324,11 +344,9 @@ def run_search(setup: TrialSetup, opts: SearchOptions, out: Path,
     return {"trials": trials, "table": table, "best": best, "files": files}
 
 
-def _fit(setup: TrialSetup, opts: SearchOptions, out: Path):
+def _fit(setup: TrialSetup, opts: SearchOptions, space: dict, out: Path):
     from ray import tune
 
-    space, decode = tune_space(setup.space, tune)
-    setup = TrialSetup(**{**setup.__dict__, "decode": frozenset(decode)})
     trainable = tune.with_resources(tune.with_parameters(run_trial, setup=setup),
                                     {"cpu": opts.cpus_per_trial})
     tuner = tune.Tuner(
@@ -346,8 +364,10 @@ def _fit(setup: TrialSetup, opts: SearchOptions, out: Path):
 
 
 def _trial_row(result, setup: TrialSetup) -> dict:
-    """One trial: its sampled values, seed, final and best score, steps, best checkpoint."""
-    cfg = {k: v for k, v in result.config.items() if k != SEED_INDEX}
+    """One trial: its sampled values (JSON-coded choices decoded), seed, final and best
+    score, steps, best checkpoint."""
+    cfg = {k: (json.loads(v) if k in setup.decode else v) for k, v in result.config.items()
+           if k != SEED_INDEX}
     df = result.metrics_dataframe
     scores = df[METRIC].to_numpy(float) if df is not None and METRIC in df else np.array([])
     ckpt = result.get_best_checkpoint(METRIC, "max") if result.best_checkpoints else None
@@ -401,8 +421,7 @@ def _copy_best(trials: list[dict], table: list[dict], setup: TrialSetup, out: Pa
     if dest.exists():
         shutil.rmtree(dest)
     shutil.copytree(top["checkpoint"], dest)
-    hp = apply_sample(setup.base, setup.space, json.loads(cfg), setup.decode)
-    _write_hp(dest / "hyperparams.yml", hp)
+    _write_hp(dest / "hyperparams.yml", trial_hyperparams(setup, json.loads(cfg)))
     return {"config": cfg, "seed": top["seed"], "best_score": top["best_score"],
             "model": str(dest / "best_model.zip"),
             "vecnormalize": str(vecnormalize_path(dest / "best_model.zip"))}
