@@ -235,6 +235,7 @@ def test_without_the_extra_commands_exit_2_with_one_line(argv, tmp_path, monkeyp
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1, err
+    assert err[0].startswith(f"aerostat-gym {argv[0]}: error: ")
     assert "needs the optional 'ray' extra" in err[0] and 'pip install -e ".[ray]"' in err[0]
 
 

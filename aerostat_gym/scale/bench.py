@@ -55,7 +55,7 @@ def throughput(base: Params, ranges: list[ParameterRange], n: int, seed: int, sp
     if repeats < 1:
         raise ValueError(f"--repeats must be >= 1, got {repeats}")
     evaluate_sample(base, ranges, [r.nominal for r in ranges], check_speeds(speeds))
-    start = start_ray("aerostat-gym montecarlo --bench", None, workers)
+    start = start_ray("the serial-vs-Ray benchmark", None, workers)
     serial, warm = [], []
     try:
         first_task = _first_task_s(start.ray)

@@ -29,23 +29,25 @@ class RayStart:
     cpus: float
 
 
-def start_ray(command: str, address: str | None = None, num_cpus: int | None = None) -> RayStart:
+def start_ray(purpose: str, address: str | None = None, num_cpus: int | None = None,
+              hint: str = "") -> RayStart:
     """Join the cluster at ``address``, or start a local one with ``num_cpus`` CPUs.
 
     Parameters
     ----------
-    command : the command asking (named in the error when Ray is missing).
+    purpose : what needs Ray (named in the error when Ray is missing).
     address : ``ray://host:10001``, ``host:6379`` or ``auto`` for an existing cluster; None
         starts a fresh local instance (never silently joins a cluster found on the machine).
     num_cpus : CPUs of the local instance (default: the machine's cores); ignored with an
         address.
+    hint : appended to the missing-extra message.
 
     Returns
     -------
     :class:`RayStart`; an already initialised session (a test fixture) is reused as is.
     """
     t0 = time.perf_counter()
-    ray = require("ray", command)
+    ray = require("ray", purpose, hint=hint)
     import_s = time.perf_counter() - t0
     if ray.is_initialized():
         return RayStart(ray, False, import_s, 0.0, ray.cluster_resources().get("CPU", 0.0))

@@ -9,22 +9,23 @@ EXTRA = "ray"
 
 
 def install_hint(extra: str = EXTRA) -> str:
-    """The install command for an extra, from a checkout or from the index."""
-    return f'pip install -e ".[{extra}]" (or pip install "aerostat-gym[{extra}]")'
+    """The install command for an extra, run in the repository root."""
+    return f'pip install -e ".[{extra}]" in the repository root'
 
 
 class MissingExtraError(RuntimeError):
     """A command needs a package of the optional extra that is not installed."""
 
 
-def require(module: str, command: str, extra: str = EXTRA) -> ModuleType:
+def require(module: str, purpose: str, extra: str = EXTRA, hint: str = "") -> ModuleType:
     """Import ``module`` or raise :class:`MissingExtraError` naming the extra to install.
 
     Parameters
     ----------
     module : dotted module name, e.g. ``"ray"`` or ``"optuna"``.
-    command : the command that needs it (for the message).
+    purpose : what needs it, for the message (e.g. "running the study on Ray").
     extra : the optional extra that provides it.
+    hint : appended to the message (e.g. an alternative that needs no extra).
 
     Returns
     -------
@@ -34,5 +35,5 @@ def require(module: str, command: str, extra: str = EXTRA) -> ModuleType:
         return importlib.import_module(module)
     except ImportError as exc:
         raise MissingExtraError(
-            f"{command} needs the optional '{extra}' extra ({module} is not importable: {exc}); "
-            f"install it with: {install_hint(extra)}") from None
+            f"{purpose} needs the optional '{extra}' extra ({module} is not importable: {exc}); "
+            f"install it with: {install_hint(extra)}{hint}") from None

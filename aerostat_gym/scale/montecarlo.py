@@ -268,7 +268,8 @@ def run_ray(base: Params, ranges: list[ParameterRange], n: int, seed: int,
     """
     speeds = check_speeds(speeds)
     values = draw_values(ranges, n, seed)
-    start = start_ray("aerostat-gym montecarlo", address, workers)
+    start = start_ray("running the study on Ray", address, workers,
+                      hint="; or run it without Ray with --serial")
     ray = start.ray
     try:
         size = batch_size or default_batch_size(n, start.cpus)

@@ -262,8 +262,8 @@ def _write_hp(path: Path, hp: dict) -> None:
 # --- the search ----------------------------------------------------------------------------------
 
 
-def _searcher(name: str, seed: int, repeat: int, command: str):
-    require("optuna", command)
+def _searcher(name: str, seed: int, repeat: int):
+    require("optuna", "the Optuna searcher")
     import optuna
     from ray.tune.search import Repeater
     from ray.tune.search.optuna import OptunaSearch
@@ -311,8 +311,7 @@ class SearchOptions:
     workers: int | None = None
 
 
-def run_search(setup: TrialSetup, opts: SearchOptions, out: Path,
-               command: str = "aerostat-gym tune") -> dict:
+def run_search(setup: TrialSetup, opts: SearchOptions, out: Path) -> dict:
     """Run the trials, gather the table and copy the best checkpoint.
 
     Parameters
@@ -320,7 +319,6 @@ def run_search(setup: TrialSetup, opts: SearchOptions, out: Path,
     setup : what every trial shares.
     opts : how to search.
     out : output directory (Ray's trial directories go to ``out/ray``).
-    command : name used in the missing-extra message.
 
     Returns
     -------
@@ -329,9 +327,9 @@ def run_search(setup: TrialSetup, opts: SearchOptions, out: Path,
     if opts.configs < 1 or not setup.seeds:
         raise ValueError(f"need --configs >= 1 and at least one seed, got {opts.configs} and "
                          f"{list(setup.seeds)}")
-    start = start_ray(command, opts.address, opts.workers)
+    start = start_ray("Ray Tune", opts.address, opts.workers)
     try:
-        tune = require("ray.tune", command)
+        tune = require("ray.tune", "Ray Tune")
         space, decode = tune_space(setup.space, tune)
         setup = TrialSetup(**{**setup.__dict__, "decode": frozenset(decode)})
         results = _fit(setup, opts, space, out.resolve())
@@ -353,8 +351,7 @@ def _fit(setup: TrialSetup, opts: SearchOptions, space: dict, out: Path):
         trainable, param_space=space,
         tune_config=tune.TuneConfig(
             metric=METRIC, mode="max", num_samples=opts.configs * len(setup.seeds),
-            search_alg=_searcher(opts.searcher, opts.search_seed, len(setup.seeds),
-                                 "aerostat-gym tune"),
+            search_alg=_searcher(opts.searcher, opts.search_seed, len(setup.seeds)),
             scheduler=_scheduler(opts.scheduler, setup.timesteps, setup.eval_freq)),
         run_config=tune.RunConfig(
             name="ray", storage_path=str(out), verbose=0,
@@ -494,9 +491,9 @@ def setup_from_args(args: argparse.Namespace) -> TrialSetup:
 
 def run_tune_command(args: argparse.Namespace) -> int:
     """``aerostat-gym tune``: run the search and print the per-configuration table."""
-    require("ray.tune", "aerostat-gym tune")
-    require("optuna", "aerostat-gym tune")
-    require("stable_baselines3", "aerostat-gym tune", extra="train")
+    require("ray.tune", "the hyperparameter search (Ray Tune)")
+    require("optuna", "the hyperparameter search (Optuna)")
+    require("stable_baselines3", "training", extra="train")
     setup = setup_from_args(args)
     opts = SearchOptions(args.configs, args.searcher, args.scheduler, args.search_seed,
                          args.cpus_per_trial, args.address, args.workers)
