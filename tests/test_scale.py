@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from aerostat_gym.agents.evaluate import evaluate as evaluate_policy
 from aerostat_gym.agents.train import load_hyperparams
 from aerostat_gym.analysis.sensitivity import DAMPING_SPEEDS, default_knobs
 from aerostat_gym.analysis.sensitivity import evaluate as sensitivity_evaluate
@@ -318,6 +319,9 @@ def test_tune_two_trials_write_the_table(ray_session, tmp_path, capsys):
     assert row["final_score_mean"] == pytest.approx(np.mean([float(t["final_score"]) for t in trials]))
     assert (out / "best" / "best_model.zip").is_file()
     assert (out / "best" / "best_model_vecnormalize.pkl").is_file()
+    # the copied checkpoint with its VecNormalize statistics scores what Tune recorded for it
+    rescored = evaluate_policy(str(out / "best" / "best_model.zip"), "damping")["score"]
+    assert rescored == pytest.approx(res["best"]["best_score"], rel=1e-9)
     best_hp = load_hyperparams("ppo", out / "best" / "hyperparams.yml")
     assert best_hp["learning_rate"] == json.loads(trials[0]["config"])["learning_rate"]
     assert best_hp["n_timesteps"] == 128 and best_hp["n_steps"] == 64
