@@ -240,6 +240,22 @@ def test_without_the_extra_commands_exit_2_with_one_line(argv, tmp_path, monkeyp
     assert "needs the optional 'ray' extra" in err[0] and 'pip install -e ".[ray]"' in err[0]
 
 
+def test_unreachable_cluster_is_one_line_exit_2(monkeypatch, capsys):
+    class FakeRay:  # stands in for ray: no session, and the cluster refuses the connection
+        @staticmethod
+        def is_initialized():
+            return False
+
+        @staticmethod
+        def init(**kwargs):
+            raise ConnectionError(f"Failed to connect to Ray cluster at {kwargs['address']}")
+
+    monkeypatch.setitem(sys.modules, "ray", FakeRay)
+    assert main(["montecarlo", "--samples", "2", "--address", "10.0.0.9:6379"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "could not join the Ray cluster at --address 10.0.0.9:6379" in err[0]
+
+
 def test_serial_path_runs_without_ray(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "ray", None)
     assert main(["montecarlo", "--samples", "1", "--serial", "--wind", "10", "--no-plot",

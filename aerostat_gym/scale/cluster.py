@@ -55,7 +55,11 @@ def start_ray(purpose: str, address: str | None = None, num_cpus: int | None = N
         raise ValueError(f"--workers must be >= 1, got {num_cpus}")
     t1 = time.perf_counter()
     if address:
-        ray.init(address=address, log_to_driver=False)
+        try:
+            ray.init(address=address, log_to_driver=False)
+        except ConnectionError as exc:
+            raise RuntimeError(f"could not join the Ray cluster at --address {address}: {exc} "
+                               "(on the head node, --address auto finds it)") from None
     else:
         ray.init(address="local", num_cpus=num_cpus or os.cpu_count(),
                  include_dashboard=False, log_to_driver=False)
