@@ -106,6 +106,9 @@ def test_a_set_that_cannot_fly_is_recorded_not_raised():
     res = evaluate_sample(BASE, [heavy], np.array([900.0]), np.array(FAST_SPEEDS))
     assert res.error.startswith(("trim failed", "invalid parameter set")), res.error
     assert np.all(np.isnan(res.stable)) and np.all(np.isnan(res.periods))
+    summary = summarize(run_serial(BASE, [heavy], 2, seed=0, speeds=FAST_SPEEDS))
+    assert (summary["n_errors"], summary["stable_everywhere"]["count"]) == (2, 0)
+    assert summary["correlations"] == [] and summary["periods_s"][PERIOD_KEYS[0]] == {"n": 0}
 
 
 # --- statistics ---------------------------------------------------------------------------------------

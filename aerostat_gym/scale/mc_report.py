@@ -84,9 +84,11 @@ def correlations(study: Study) -> list[dict]:
     Spearman rho with the largest Re(lambda) over the sweep, and the instability rate in the
     lowest and highest fifth of its range; sorted by |r| (then |rho|)."""
     ok = complete_mask(study)
+    if ok.sum() < 2:
+        return []
     values = study.stack("values")[ok]
     unstable = (~stable_everywhere(study)[ok]).astype(float)
-    margin = np.nanmax(study.stack("max_real")[ok], axis=1) if ok.any() else np.array([])
+    margin = np.nanmax(study.stack("max_real")[ok], axis=1)
     rows = []
     for i, key in enumerate(study.keys):
         lo, hi = study.ranges[i]

@@ -198,6 +198,8 @@ def evaluate_sample(base: Params, ranges: list[ParameterRange], values: np.ndarr
                 _record(res, int(hit[0]), an)
     except TrimError as exc:
         res.error = f"trim failed: {exc}"
+    except np.linalg.LinAlgError as exc:
+        res.error = f"eigen-decomposition failed at U = {u} m/s: {exc}"
     return res
 
 
