@@ -263,6 +263,8 @@ def test_serial_path_runs_without_ray(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "ray", None)
     assert main(["montecarlo", "--samples", "1", "--serial", "--wind", "10", "--no-plot",
                  "--out", str(tmp_path / "mc")]) == 0
+    summary = json.loads((tmp_path / "mc" / "summary.json").read_text())
+    assert summary["samples"] == 1 and summary["correlations"] == []  # one set: nothing to correlate
     with pytest.raises(MissingExtraError, match="'ray' extra"):
         require("ray", "x")
 

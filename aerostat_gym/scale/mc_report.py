@@ -93,10 +93,9 @@ def correlations(study: Study) -> list[dict]:
     for i, key in enumerate(study.keys):
         lo, hi = study.ranges[i]
         low_rate, high_rate = _tail_rates(values[:, i], unstable, lo, hi)
-        rows.append({"parameter": key, "low": lo, "high": hi,
-                     "r_unstable": point_biserial(values[:, i], unstable),
-                     "rho_max_real": spearman(values[:, i], margin),
-                     "unstable_rate_low_fifth": low_rate, "unstable_rate_high_fifth": high_rate})
+        rows.append(dict(zip(CORRELATION_FIELDS, (
+            key, lo, hi, point_biserial(values[:, i], unstable), spearman(values[:, i], margin),
+            low_rate, high_rate), strict=True)))
 
     def order(r):
         a, b = abs(r["r_unstable"]), abs(r["rho_max_real"])
@@ -179,9 +178,14 @@ def sample_rows(study: Study) -> list[dict]:
     return rows
 
 
-def _write_csv(path: Path, rows: list[dict]) -> None:
+CORRELATION_FIELDS = ("parameter", "low", "high", "r_unstable", "rho_max_real",
+                      "unstable_rate_low_fifth", "unstable_rate_high_fifth")
+
+
+def _write_csv(path: Path, rows: list[dict], fields=None) -> None:
+    """Rows as CSV; with no rows, the header of ``fields`` only."""
     with path.open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]) if rows else list(fields or ()))
         w.writeheader()
         w.writerows(rows)
 
@@ -201,7 +205,7 @@ def write_outputs(study: Study, summary: dict, out: Path, plot: bool = True) -> 
              out / "summary.json"]
     _write_csv(files[0], sample_rows(study))
     _write_csv(files[1], summary["stability"])
-    _write_csv(files[2], summary["correlations"])
+    _write_csv(files[2], summary["correlations"], CORRELATION_FIELDS)
     files[3].write_text(json.dumps(summary, indent=1, default=float))
     if plot:
         files.append(plot_study(study, summary, out / "montecarlo.png"))
