@@ -112,13 +112,15 @@ def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict 
 def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | None = None,
           n_envs: int | None = None, seed: int = 0, run_dir: str | Path | None = None,
           resume: str | Path | None = None, progress_bar: bool = True, threads: int | None = None,
-          eval_freq: int | None = None, params=None) -> Path:
+          eval_freq: int | None = None, params=None, on_eval=None) -> Path:
     """Train and return the run directory (see the module docstring).
 
     ``hyperparams`` is the YAML file (default: the shipped one for ``algo``); ``params`` the
     physics configuration (a Params, a TOML path or a shipped name; default the baseline), used
     by the training environments and the suite evaluations and written to ``params.toml`` in
-    the run directory.
+    the run directory. ``on_eval(record, run)``, if given, is called after every suite
+    evaluation (``record`` as in evaluations.json, plus ``"best"``: whether best_model.zip was
+    just saved).
     """
     import torch
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
@@ -144,7 +146,7 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
         CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"), name_prefix=algo,
                            save_vecnormalize=True),
         suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1), run,
-                            env_kwargs.get("params")),
+                            env_kwargs.get("params"), on_eval),
     ])
     t0 = time.perf_counter()
     model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress_bar,
@@ -161,7 +163,7 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     return run
 
 
-def suite_eval_callback(suite: str, freq: int, run: Path, params=None):
+def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=None):
     """A callback that, every ``freq`` calls, scores the current policy on the fixed suite
     (deterministic actions, the training VecNormalize statistics), logs it, appends it to
     ``evaluations.json`` and saves the best-scoring model (with its statistics) as
@@ -191,9 +193,12 @@ def suite_eval_callback(suite: str, freq: int, run: Path, params=None):
             self.history.append({"timesteps": int(self.num_timesteps), "score": score,
                                  "wall_time_s": time.perf_counter() - self.t0})
             (Path(run) / "evaluations.json").write_text(json.dumps(self.history, indent=1))
-            if score > self.best:
+            best = score > self.best
+            if best:
                 self.best = score
                 save_model(self.model, Path(run) / "best_model.zip")
+            if on_eval is not None:
+                on_eval({**self.history[-1], "best": best}, Path(run))
 
     return SuiteEvalCallback()
 

@@ -3,7 +3,8 @@
 Commands: ``trim`` (equilibrium summary), ``params`` (every parameter with its unit and status),
 ``bench`` (speed and accuracy figures), ``wind`` (turbulence statistics), ``stability``,
 ``table2`` and ``sensitivity`` (linear stability analysis), ``train``, ``evaluate`` and ``demo``
-(winch-control agents). Errors in user input print one clear line and exit with status 2.
+(winch-control agents), ``tune`` and ``montecarlo`` (Ray, the optional extra). Errors in user
+input print one clear line and exit with status 2.
 
 One module per group of commands (``model``, ``wind``, ``stability``, ``agents``), each with an
 ``add_*_parsers`` function; ``common`` holds the options they share.
@@ -17,6 +18,7 @@ import sys
 from ..params import ParameterError
 from .agents import add_agent_parsers
 from .model import add_model_parsers
+from .scale import add_montecarlo_parser, add_tune_parser
 from .stability import add_stability_parsers
 from .wind import add_wind_parser
 
@@ -40,6 +42,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_wind_parser(sub)
     add_stability_parsers(sub)
     add_agent_parsers(sub)
+    add_tune_parser(sub)
+    add_montecarlo_parser(sub)
     return ap
 
 

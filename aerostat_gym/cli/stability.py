@@ -57,7 +57,7 @@ def parse_speeds(text: str) -> np.ndarray:
     return speeds
 
 
-def _params(args):
+def stability_params(args):
     return params_from_args(args, **{"tether.length": getattr(args, "length", None),
                                      "tether.n_elements": getattr(args, "elements", None)})
 
@@ -93,7 +93,7 @@ def _stability_text(sweep, dec_ratios: list[dict]) -> str:
 
 
 def cmd_stability(args) -> int:
-    params = _params(args)
+    params = stability_params(args)
     speeds = parse_speeds(args.wind)
     sweep = wind_sweep(params, speeds)
     ratios = [a.decoupled.ratios for a in sweep.analyses]
@@ -121,13 +121,13 @@ def _json_default(v):
 
 
 def cmd_table2(args) -> int:
-    rows = table2(_params(args))
+    rows = table2(stability_params(args))
     print(json.dumps(rows, indent=1) if args.json else format_table2(rows))
     return 0
 
 
 def cmd_sensitivity(args) -> int:
-    params = _params(args)
+    params = stability_params(args)
     speeds = parse_speeds(args.wind) if args.wind else DAMPING_SPEEDS
     if np.any(np.asarray(speeds) <= 0):
         raise ValueError("sensitivity --wind speeds must be > 0 (at 0 m/s every mode is undamped)")
