@@ -11,9 +11,11 @@ set-point come from the winch state and the action.
 Brake logic. The shipped winch engages its brake whenever |v_set| < winch.brake_speed
 (0.02 m/s), which swallows the small commands of a linear controller near the end of a swing
 (and all of them at a 0.5-1 m swing). ``brake_speed=0`` turns this dead band off, which is what
-a dwell-time brake (:func:`aerostat_gym.agents.brake_dwell.dwell_brake_rule`: engage only after
-the command has stayed near zero for a dwell time) does for a controller whose command keeps
-moving; the runs report which brake they used.
+a dwell-time brake (:func:`aerostat_gym.winch_dwell.dwell_brake_rule`: engage only after the
+command has stayed near zero for a dwell time) does for a controller whose command keeps
+moving. :func:`swing_response_dwell` runs the dwell-time rule itself, through
+:func:`aerostat_gym.simulation.simulate` (the environment's compiled step still applies the
+shipped rule), for policies that read the privileged full observation.
 """
 
 from __future__ import annotations
@@ -24,7 +26,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..envs.vector import TetheredAerostatVectorEnv
+from ..params import apply_overrides, load_params
+from ..simulation import simulate
+from ..winch_dwell import DEFAULT_DWELL_TIME, DwellBrake
 from .evaluate import policy_obs
+from .lqr import OBS_STATE_OFFSET, OBS_WIND_INDEX
 from .metrics import fit_damped_sinusoid
 
 
@@ -163,13 +169,78 @@ def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: floa
                     v[:k_end + 1], sp[:k_end], fit.zeta, fit.period, fit.r2, ended)
 
 
-def initial_deviation(wind_speed: float, swing: float, params=None) -> np.ndarray:
-    """The environment's start of a swing-recovery run as a deviation from trim (6n+8)."""
+def initial_state(wind_speed: float, swing: float, params=None) -> tuple[np.ndarray, np.ndarray]:
+    """(x0, x_trim): the environment's start of a swing-recovery run and its trim (6n+8)."""
     env = swing_env(wind_speed, swing, params=params)
     env.reset(seed=[0], options={"wind_speed": [wind_speed]})
-    dx = env.batch.X[0] - env.batch.XT[0]
+    x0, xt = env.batch.X[0].copy(), env.batch.XT[0].copy()
     env.close()
-    return dx
+    return x0, xt
+
+
+def initial_deviation(wind_speed: float, swing: float, params=None) -> np.ndarray:
+    """The environment's start of a swing-recovery run as a deviation from trim (6n+8)."""
+    x0, xt = initial_state(wind_speed, swing, params)
+    return x0 - xt
+
+
+def swing_response_dwell(policy, wind_speed: float, swing: float, *,
+                         dwell: float = DEFAULT_DWELL_TIME, params=None, duration: float = 180.0,
+                         control_step: float = 0.2) -> SwingRun:
+    """:func:`swing_response` with the dwell-time brake logic, for a full-observation policy.
+
+    Parameters
+    ----------
+    policy : object
+        A policy reading the privileged full observation (wind speed at index 19, x - x_trim
+        from index 20), e.g. :class:`~aerostat_gym.agents.lqr.LQRPolicy`.
+    wind_speed : float
+        Mean wind speed [m/s].
+    swing : float
+        Initial along-wind swing [m].
+    dwell : float
+        Stand-still time before the brake is applied [s].
+    params : Params or None
+        Parameters (default: the shipped baseline); its winch.brake_speed is the stand-still
+        band of the dwell rule.
+    duration : float
+        Length of the run [s].
+    control_step : float
+        Control step [s] (the policy's and the winch logic's rate).
+
+    Returns
+    -------
+    SwingRun
+        With the semi-implicit integrator, as the environment uses.
+    """
+    params = params or load_params()
+    x0, xt = initial_state(wind_speed, swing, params)
+    brake = DwellBrake(params.winch.brake_speed, control_step, dwell)
+    vmax = float(params.winch.max_speed)
+    lay_size = x0.size
+    n = (lay_size - 8) // 6
+    o = 6 * (n - 1)  # first aerostat entry of the layout (CM position)
+    i_psi = o + 8
+    memo = {"state": None, "start": np.ones(1, bool), "sp": []}
+
+    def u(t, x):
+        dx = x - xt
+        dx[i_psi] = (dx[i_psi] + np.pi) % (2.0 * np.pi) - np.pi
+        obs = np.zeros(OBS_STATE_OFFSET + lay_size)
+        obs[OBS_WIND_INDEX], obs[OBS_STATE_OFFSET:] = wind_speed, dx
+        a, memo["state"] = policy.predict(obs, memo["state"], memo["start"])
+        memo["start"][:] = False
+        v = float(np.clip(a[0], -1.0, 1.0)) * vmax
+        memo["sp"].append(v)
+        return brake(v)
+
+    tr = simulate(apply_overrides(params, {"winch.brake_speed": 0.0}), x0, duration,
+                  wind=wind_speed, integrator="semi-implicit", output_dt=control_step, u=u)
+    x = tr.cm_pos[:, 0] - xt[o]
+    fit = fit_damped_sinusoid(tr.time, x)
+    return SwingRun(float(wind_speed), float(swing), tr.time, x, tr.length - xt[o + 12],
+                    tr.reel_speed, np.array(memo["sp"]), fit.zeta, fit.period, fit.r2,
+                    None if tr.status == "ok" else tr.status)
 
 
 def linear_response(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, steps: int
