@@ -258,6 +258,14 @@ def stratified_resample(scores: np.ndarray, rng: np.random.Generator) -> np.ndar
     return np.take_along_axis(scores, idx, axis=0)
 
 
+def _stratified_batch(scores: np.ndarray, rng: np.random.Generator, resamples: int
+                      ) -> np.ndarray:
+    """``resamples`` stratified replicates at once, shape (resamples, runs, tasks)."""
+    runs, tasks = scores.shape
+    idx = rng.integers(0, runs, size=(resamples, runs, tasks))
+    return scores[idx, np.arange(tasks)[None, None, :]]
+
+
 def iqm_ci(scores, confidence: float = DEFAULT_CONFIDENCE, resamples: int = DEFAULT_RESAMPLES,
            seed: int = 0) -> Interval:
     """Interquartile mean of a (runs, tasks) matrix with a stratified-bootstrap percentile
@@ -281,9 +289,8 @@ def iqm_ci(scores, confidence: float = DEFAULT_CONFIDENCE, resamples: int = DEFA
     """
     _check_level(confidence, resamples)
     s = _matrix(scores, "scores")
-    rng = np.random.default_rng(seed)
-    boot = np.array([stats.trim_mean(stratified_resample(s, rng).ravel(), 0.25)
-                     for _ in range(resamples)])
+    boot = stats.trim_mean(_stratified_batch(s, np.random.default_rng(seed), resamples)
+                           .reshape(resamples, -1), 0.25, axis=1)
     lo, hi = _percentile(boot, 1.0 - confidence)
     return Interval(interquartile_mean(s), lo, hi, float(confidence), int(s.shape[0]))
 
@@ -326,9 +333,10 @@ def probability_of_improvement_ci(x, y, confidence: float = DEFAULT_CONFIDENCE,
     xs, ys = _matrix(x, "x"), _matrix(y, "y")
     estimate = probability_of_improvement(xs, ys)
     rng = np.random.default_rng(seed)
-    boot = np.array([np.mean(_poi_per_task(stratified_resample(xs, rng),
-                                           stratified_resample(ys, rng)))
-                     for _ in range(resamples)])
+    xb, yb = _stratified_batch(xs, rng, resamples), _stratified_batch(ys, rng, resamples)
+    gt = (xb[:, :, None, :] > yb[:, None, :, :]).mean(axis=(1, 2))
+    eq = (xb[:, :, None, :] == yb[:, None, :, :]).mean(axis=(1, 2))
+    boot = np.mean(gt + 0.5 * eq, axis=1)
     lo, hi = _percentile(boot, 1.0 - confidence)
     return Interval(estimate, lo, hi, float(confidence), int(min(xs.shape[0], ys.shape[0])))
 
