@@ -38,9 +38,9 @@ MODAL_ZETAS = {5.0: (0.16, 0.18, 0.20, 0.22, 0.25), 10.0: (0.35, 0.45, 0.55, 0.6
 LQG_NOISE = 0.01
 
 
-def _row(policy, brake, predicted, run, linear_fit=float("nan")):
+def _row(policy, brake, predicted, run, linear_fit=(float("nan"), float("nan"))):
     return {"policy": policy, "brake": brake, "predicted_zeta": predicted,
-            "linear_fit_zeta": linear_fit, **run.row()}
+            "linear_fit_zeta": linear_fit[0], "linear_drift_zeta": linear_fit[1], **run.row()}
 
 
 def baselines_at(params, U, swing):
@@ -85,14 +85,15 @@ def modal_curve_at(params, U, swing, zetas):
 
 
 def table(rows) -> str:
-    head = ("| U [m/s] | policy | brake | designed zeta | linear-fit zeta | measured zeta | "
-            "fit r2 | peak set-point [m/s] | peak reel speed [m/s] | length wander [m] |\n"
-            "|---|---|---|---|---|---|---|---|---|---|")
+    head = ("| U [m/s] | policy | brake | designed zeta | linear: 1-mode fit | linear: drift "
+            "fit | measured: 1-mode fit | measured: drift fit | peak set-point [m/s] | peak reel "
+            "speed [m/s] | length wander [m] |\n|---|---|---|---|---|---|---|---|---|---|---|")
     lines = [head]
     for r in rows:
         lines.append(f"| {r['wind_speed']:g} | {r['policy']} | {r['brake']} | "
-                     f"{r['predicted_zeta']:.3f} | {r['linear_fit_zeta']:.3f} | {r['zeta']:.3f} | "
-                     f"{r['fit_r2']:.3f} | {r['peak_set_point_m_s']:.3f} | "
+                     f"{r['predicted_zeta']:.3f} | {r['linear_fit_zeta']:.3f} | "
+                     f"{r['linear_drift_zeta']:.3f} | {r['zeta']:.3f} | {r['zeta_drift']:.3f} | "
+                     f"{r['peak_set_point_m_s']:.3f} | "
                      f"{r['peak_reel_speed_m_s']:.3f} | {r['length_wander_m']:.2f} |")
     return "\n".join(lines)
 

@@ -32,6 +32,7 @@ from ..winch_dwell import DEFAULT_DWELL_TIME, DwellBrake
 from .evaluate import policy_obs
 from .lqr import OBS_STATE_OFFSET, OBS_WIND_INDEX
 from .metrics import fit_damped_sinusoid
+from .metrics_drift import fit_pendulum_with_drift
 
 
 @dataclass
@@ -62,6 +63,9 @@ class SwingRun:
         Coefficient of determination of that fit.
     ended : str or None
         Termination reason, None for a full run.
+    zeta_drift : float
+        Pendulum damping ratio of the sinusoid-plus-drift fit
+        (:func:`aerostat_gym.agents.metrics_drift.fit_pendulum_with_drift`).
     """
 
     wind_speed: float
@@ -75,6 +79,7 @@ class SwingRun:
     period: float
     r2: float
     ended: str | None
+    zeta_drift: float = math.nan
 
     @property
     def peak_reel_speed(self) -> float:
@@ -91,6 +96,7 @@ class SwingRun:
 
     def row(self) -> dict:
         return {"wind_speed": self.wind_speed, "swing_m": self.swing, "zeta": self.zeta,
+                "zeta_drift": self.zeta_drift,
                 "period_s": self.period, "fit_r2": self.r2,
                 "peak_reel_speed_m_s": self.peak_reel_speed,
                 "peak_set_point_m_s": self.peak_set_point,
@@ -165,8 +171,9 @@ def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: floa
     env.close()
     t = np.arange(k_end + 1) * control_step
     fit = fit_damped_sinusoid(t, x[:k_end + 1])
+    drift = fit_pendulum_with_drift(t, x[:k_end + 1])
     return SwingRun(float(wind_speed), float(swing), t, x[:k_end + 1], L[:k_end + 1],
-                    v[:k_end + 1], sp[:k_end], fit.zeta, fit.period, fit.r2, ended)
+                    v[:k_end + 1], sp[:k_end], fit.zeta, fit.period, fit.r2, ended, drift.zeta)
 
 
 def initial_state(wind_speed: float, swing: float, params=None) -> tuple[np.ndarray, np.ndarray]:
@@ -238,9 +245,10 @@ def swing_response_dwell(policy, wind_speed: float, swing: float, *,
                   wind=wind_speed, integrator="semi-implicit", output_dt=control_step, u=u)
     x = tr.cm_pos[:, 0] - xt[o]
     fit = fit_damped_sinusoid(tr.time, x)
+    drift = fit_pendulum_with_drift(tr.time, x)
     return SwingRun(float(wind_speed), float(swing), tr.time, x, tr.length - xt[o + 12],
                     tr.reel_speed, np.array(memo["sp"]), fit.zeta, fit.period, fit.r2,
-                    None if tr.status == "ok" else tr.status)
+                    None if tr.status == "ok" else tr.status, drift.zeta)
 
 
 def linear_response(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, steps: int
@@ -263,9 +271,10 @@ def modal_linear_peak(design, dx0_full: np.ndarray, duration: float = 180.0) -> 
 
 
 def linear_fit_zeta(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, i_x: int,
-                    duration: float = 180.0, dt: float = 0.2) -> float:
-    """Pendulum damping ratio that :func:`fit_damped_sinusoid` finds in the linear closed
-    loop's along-wind CM displacement (state ``i_x`` of ``dx0``'s layout) from ``dx0``.
+                    duration: float = 180.0, dt: float = 0.2) -> tuple[float, float]:
+    """Pendulum damping ratios that :func:`fit_damped_sinusoid` and
+    :func:`~aerostat_gym.agents.metrics_drift.fit_pendulum_with_drift` find in the linear
+    closed loop's along-wind CM displacement (state ``i_x`` of ``dx0``'s layout) from ``dx0``.
 
     Notes
     -----
@@ -276,4 +285,6 @@ def linear_fit_zeta(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, i_x: int,
     """
     steps = int(round(duration / dt))
     X, _ = linear_response(Acl, K, dx0, steps)
-    return fit_damped_sinusoid(np.arange(steps + 1) * dt, X[:, i_x]).zeta
+    t = np.arange(steps + 1) * dt
+    return (fit_damped_sinusoid(t, X[:, i_x]).zeta,
+            fit_pendulum_with_drift(t, X[:, i_x]).zeta)
