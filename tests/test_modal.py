@@ -134,10 +134,12 @@ def _nonlinear(params, U, swing):
 def test_nonlinear_damping_10ms_10m(params):
     """Environment, 10 m/s, 10 m swing, brake dead band off: fitted pendulum damping within 20 %
     of the designed 0.60 (measured 0.545) and within 5 % of the same fit of the linear closed
-    loop (measured 0.568); at least 0.5 at a peak reel speed within 1 m/s (measured 0.715)."""
+    loop (measured 0.568); the sinusoid-plus-drift fit within 5 % of the designed value
+    (measured 0.611); at least 0.5 at a peak reel speed within 1 m/s (measured 0.715)."""
     run, d, lin = _nonlinear(params, 10.0, 10.0)
     assert run.ended is None and run.r2 > 0.99
     assert run.zeta == pytest.approx(d.zeta, rel=0.20)
+    assert run.zeta_drift == pytest.approx(d.zeta, rel=0.05)  # measured 0.611
     assert run.zeta == pytest.approx(lin.zeta, rel=0.05)
     assert run.zeta >= 0.5 and run.peak_reel_speed < 1.0
 
@@ -147,9 +149,29 @@ def test_nonlinear_damping_10ms_10m(params):
 def test_nonlinear_damping_other_cases(params, U, swing, floor):
     """The other three cases of the acceptance grid, brake dead band off: within 20 % of the
     designed zeta and 5 % of the linear closed loop's fit, above the floor (measured 0.570,
-    0.753, 0.755 against designed 0.60, 0.85, 0.85)."""
+    0.753, 0.755 against designed 0.60, 0.85, 0.85); the drift fit within 5 % of the designed
+    value (measured 0.605, 0.858, 0.872)."""
     run, d, lin = _nonlinear(params, U, swing)
     assert run.ended is None
     assert run.zeta == pytest.approx(d.zeta, rel=0.20)
+    assert run.zeta_drift == pytest.approx(d.zeta, rel=0.05)
     assert run.zeta == pytest.approx(lin.zeta, rel=0.05)
     assert run.zeta >= floor and run.peak_reel_speed < 1.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("U, swing, measured", [(10.0, 10.0, 0.603), (15.0, 10.0, 0.861),
+                                                (15.0, 1.0, 0.766)])
+def test_nonlinear_damping_dwell_brake(params, U, swing, measured):
+    """With the 10 s dwell-time brake (through simulate): the drift fit within 20 % of the
+    designed zeta and within 0.01 of the value measured when this test was written. ~5 s each.
+    (At 10 m/s, 1 m the brake engages in the tail and the drift fit reads 0.738, 23 % high;
+    that case is not asserted.)"""
+    from aerostat_gym.agents.frontier import swing_response_dwell
+
+    sch = ModalSchedule(params, speeds=np.array([U]), dt=DT)
+    run = swing_response_dwell(ModalPolicy(params, dt=DT, schedule=sch), U, swing,
+                               params=params)
+    assert run.ended is None
+    assert run.zeta_drift == pytest.approx(sch.designs[0].zeta, rel=0.20)
+    assert run.zeta_drift == pytest.approx(measured, abs=0.01)
