@@ -10,8 +10,9 @@ a while, so here the brake is wanted when
 
 - it is commanded, or the set-point is exactly 0 (the environment's action 0, the passive
   braked winch, keeps its meaning), or
-- |v_set| has stayed below ``brake_speed`` for at least ``dwell`` seconds (``quiet`` counts that
-  time and restarts at 0 whenever |v_set| >= brake_speed).
+- |v_set| has stayed below ``brake_speed`` (the stand-still band; proposed
+  :data:`DEFAULT_STANDSTILL_BAND` = 0.002 m/s) for at least ``dwell`` seconds (``quiet``
+  counts that time and restarts at 0 whenever |v_set| >= brake_speed).
 
 Until then a small set-point goes to the speed loop unchanged. Once wanted, the brake clamps the
 drum as before: at once if it already held it or once |v_w| <= ``hold_speed``; meanwhile the
@@ -28,8 +29,13 @@ from numba import njit
 
 from .winch import brake_rule
 
-#: Time the set-point must stay below brake_speed before the brake is applied [s].
+#: Time the set-point must stay inside the stand-still band before the brake is applied [s].
 DEFAULT_DWELL_TIME = 10.0
+#: Stand-still band of the set-point [m/s]: a tenth of the shipped 0.02 m/s dead band. With the
+#: 0.02 m/s band and a 10 s dwell the brake still sets in the tail of a small swing and cuts it
+#: (measured, 0.5 m swing at 15 m/s: LQR 0.384 against its linear 0.581); with 0.002 m/s every
+#: baseline's damping is within 4 % of its linear value at 0.5, 1 and 10 m swings.
+DEFAULT_STANDSTILL_BAND = 0.002
 
 
 @njit(cache=True)

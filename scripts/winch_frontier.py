@@ -7,8 +7,8 @@ Usage::
     PYTHONPATH=. python scripts/winch_frontier.py [--swing 10] [--json out.json]
 
 Brake logic per row: "dead band" is the shipped rule (brake below 0.02 m/s), "off" the dead band
-removed (winch.brake_speed = 0), "dwell" the 10 s dwell-time rule run through simulate()
-(full-state policies only). The LQG reads the standard observation with sensor noise
+removed (winch.brake_speed = 0), "dwell" the dwell-time rule (brake after 10 s inside a 0.002 m/s
+stand-still band) run through simulate() (full-state policies only). The LQG reads the standard observation with sensor noise
 obs_noise = 0.01 (scaled units) and its filter is designed for that noise.
 """
 

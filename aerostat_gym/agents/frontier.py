@@ -28,7 +28,7 @@ import numpy as np
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import apply_overrides, load_params
 from ..simulation import simulate
-from ..winch_dwell import DEFAULT_DWELL_TIME, DwellBrake
+from ..winch_dwell import DEFAULT_DWELL_TIME, DEFAULT_STANDSTILL_BAND, DwellBrake
 from .evaluate import policy_obs
 from .lqr import OBS_STATE_OFFSET, OBS_WIND_INDEX
 from .metrics import fit_damped_sinusoid
@@ -192,7 +192,9 @@ def initial_deviation(wind_speed: float, swing: float, params=None) -> np.ndarra
 
 
 def swing_response_dwell(policy, wind_speed: float, swing: float, *,
-                         dwell: float = DEFAULT_DWELL_TIME, params=None, duration: float = 180.0,
+                         dwell: float = DEFAULT_DWELL_TIME,
+                         band: float = DEFAULT_STANDSTILL_BAND,
+                         params=None, duration: float = 180.0,
                          control_step: float = 0.2) -> SwingRun:
     """:func:`swing_response` with the dwell-time brake logic, for a full-observation policy.
 
@@ -207,9 +209,10 @@ def swing_response_dwell(policy, wind_speed: float, swing: float, *,
         Initial along-wind swing [m].
     dwell : float
         Stand-still time before the brake is applied [s].
+    band : float
+        Stand-still band of the set-point [m/s] (default 0.002, the proposal).
     params : Params or None
-        Parameters (default: the shipped baseline); its winch.brake_speed is the stand-still
-        band of the dwell rule.
+        Parameters (default: the shipped baseline).
     duration : float
         Length of the run [s].
     control_step : float
@@ -222,7 +225,7 @@ def swing_response_dwell(policy, wind_speed: float, swing: float, *,
     """
     params = params or load_params()
     x0, xt = initial_state(wind_speed, swing, params)
-    brake = DwellBrake(params.winch.brake_speed, control_step, dwell)
+    brake = DwellBrake(band, control_step, dwell)
     vmax = float(params.winch.max_speed)
     lay_size = x0.size
     n = (lay_size - 8) // 6
