@@ -15,7 +15,7 @@ CLASSICAL = ("modal", "lqg")
 
 def load_classical(name: str, params: Params | None = None, dt: float = 0.2,
                    obs_noise: float = 0.0):
-    """A modal or LQG baseline, its gain tables built for ``params`` (2-16 m/s, ~10 s each).
+    """A modal or LQG baseline, its gain tables built for ``params`` (2-16 m/s).
 
     Parameters
     ----------

@@ -358,7 +358,7 @@ class ModalPolicy(LQRPolicy):
     dt : float
         Control step [s] (must match the schedule's).
     schedule : ModalSchedule or None
-        The gain table (default: built here with :func:`default_zeta`, ~1 min).
+        The gain table (default: built here over 2-16 m/s with :func:`default_zeta`).
 
     Notes
     -----
