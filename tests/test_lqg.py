@@ -9,6 +9,7 @@ brake dead band off: pendulum damping 0.325 against the LQR's linear prediction 
 
 import numpy as np
 import pytest
+from scipy.optimize import linear_sum_assignment
 
 from aerostat_gym.agents.frontier import swing_response
 from aerostat_gym.agents.lqg import (
@@ -103,8 +104,6 @@ def test_separation_closed_loop_poles(schedule):
     the estimator's (matched one to one within 1e-8). In the coordinates (x, e-) with e- the
     a-priori error, x+ = (Ad - Bd K) x + Bd K (I - L C) e- and e-+ = Ad (I - L C) e-; the
     spectrum of Ad (I - L C) is that of (I - L C) Ad."""
-    from scipy.optimize import linear_sum_assignment
-
     d = schedule.designs[0]
     n = d.index.size
     Ad, Bd, K, L, C = d.Ad, d.Bd, d.K[None, :], d.L, d.C

@@ -6,6 +6,7 @@ states its tolerance.
 
 import numpy as np
 import pytest
+from scipy import stats
 
 from aerostat_gym.agents.protocol_stats import (
     StatsInputError,
@@ -55,8 +56,6 @@ def test_studentized_interval_width_matches_t_interval():
     """For normal data the bootstrap-t interval approaches the Student-t interval
     mean +- t_(0.975, n-1) s / sqrt(n): the two half-widths agree within 10 % at n = 40
     (the bootstrap t-quantiles carry resampling error)."""
-    from scipy import stats
-
     x = np.random.default_rng(5).normal(0.0, 1.0, 40)
     ci = bootstrap_mean_ci(x, resamples=20000, seed=3)
     half = stats.t.ppf(0.975, 39) * np.std(x, ddof=1) / np.sqrt(40)

@@ -4,6 +4,7 @@ a two-seed baseline table (slow). Every assertion states its tolerance.
 """
 
 import importlib.util
+import json
 import math
 from pathlib import Path
 
@@ -56,8 +57,6 @@ def test_baseline_table_two_seeds(tmp_path):
     bt = load("baseline_table")
     out = tmp_path / "t.json"
     bt.main(["--seeds", "2", "--json", str(out)])
-    import json
-
     data = json.loads(out.read_text())
     for cell in data["cells"].values():
         for r in cell["rows"]:

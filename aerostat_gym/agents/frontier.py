@@ -33,6 +33,7 @@ from .evaluate import policy_obs
 from .lqr import OBS_STATE_OFFSET, OBS_WIND_INDEX
 from .metrics import fit_damped_sinusoid
 from .metrics_drift import fit_pendulum_with_drift
+from .modal import design_modal
 
 
 @dataclass
@@ -291,3 +292,30 @@ def linear_fit_zeta(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, i_x: int,
     t = np.arange(steps + 1) * dt
     return (fit_damped_sinusoid(t, X[:, i_x]).zeta,
             fit_pendulum_with_drift(t, X[:, i_x]).zeta)
+
+
+def modal_peak_limit(params, wind_speed: float, swing: float, peak: float = 1.0,
+                     tol: float = 1e-3, dt: float = 0.2) -> tuple[float, float]:
+    """(zeta, peak set-point): the largest modal pendulum damping whose linear closed loop asks
+    for at most ``peak`` [m/s] from a ``swing`` [m] along-wind start, by bisection on zeta
+    between the open-loop value and 0.99 (the peak set-point grows with zeta).
+
+    This is the modal controller's own frontier end at the winch's speed limit, not a bound
+    over every controller.
+    """
+    dx0 = initial_deviation(wind_speed, swing, params)
+    first = design_modal(params, wind_speed, 0.5, dt)
+    lo = float(first.lqr.mode("pendulum", "open").zeta) + 1e-3
+    hi = 0.99
+
+    def peak_at(z):
+        return modal_linear_peak(design_modal(params, wind_speed, z, dt, lqr=first.lqr), dx0)
+
+    if peak_at(lo) > peak:
+        return lo, peak_at(lo)
+    if peak_at(hi) <= peak:
+        return hi, peak_at(hi)
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if peak_at(mid) <= peak else (lo, mid)
+    return lo, peak_at(lo)

@@ -35,6 +35,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
 from ..analysis.trim import Equilibrium, find_equilibrium
 from ..params import Params
@@ -206,8 +207,6 @@ class ModalDesign:
 def pole_set_distance(actual: np.ndarray, expected: np.ndarray) -> float:
     """max_i |expected_i - actual_pi(i)| over the one-to-one matching pi that minimises the
     total distance (Hungarian assignment)."""
-    from scipy.optimize import linear_sum_assignment
-
     cost = np.abs(expected[:, None] - actual[None, :])
     r, c = linear_sum_assignment(cost)
     return float(np.max(cost[r, c]))
