@@ -18,11 +18,11 @@ import json
 
 import numpy as np
 
-from aerostat_gym.agents.baselines import PassivePolicy, TensionFeedbackPolicy
 from aerostat_gym.agents.evaluate import episode_metrics, run_scenario
 from aerostat_gym.agents.lqg import LQGPolicy
 from aerostat_gym.agents.lqr import LQRPolicy
 from aerostat_gym.agents.modal import ModalPolicy
+from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy
 from aerostat_gym.agents.protocol_table import aggregate_table, cell_table, markdown
 from aerostat_gym.params import load_params
 

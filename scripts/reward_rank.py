@@ -19,12 +19,12 @@ import json
 import numpy as np
 from scipy import stats
 
-from aerostat_gym.agents.baselines import PassivePolicy, TensionFeedbackPolicy
 from aerostat_gym.agents.evaluate import episode_metrics, run_scenario
 from aerostat_gym.agents.lqg import LQGPolicy
 from aerostat_gym.agents.lqr import LQRPolicy
 from aerostat_gym.agents.metrics_drift import fit_pendulum_with_drift
 from aerostat_gym.agents.modal import ModalPolicy
+from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy
 from aerostat_gym.params import load_params
 
 SPEEDS = [3.0, 5.0, 7.5, 10.0, 12.5, 15.0]

@@ -19,7 +19,6 @@ import json
 
 import numpy as np
 
-from aerostat_gym.agents.baselines import PassivePolicy
 from aerostat_gym.agents.frontier import (
     initial_deviation,
     linear_fit_zeta,
@@ -30,6 +29,7 @@ from aerostat_gym.agents.frontier import (
 from aerostat_gym.agents.lqg import LQGPolicy, LQGSchedule
 from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule
 from aerostat_gym.agents.modal import ModalPolicy, ModalSchedule, default_zeta
+from aerostat_gym.agents.policies import PassivePolicy
 from aerostat_gym.params import load_params
 
 SPEEDS = (5.0, 10.0, 15.0)

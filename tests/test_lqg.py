@@ -22,7 +22,7 @@ from aerostat_gym.agents.lqg import (
 )
 from aerostat_gym.envs.spaces import CHANNELS, N_OBS
 from aerostat_gym.params import load_params
-from aerostat_gym.simulation import Model
+from aerostat_gym.sim import Model
 
 DT = 0.2
 NOISE = 0.01

@@ -23,7 +23,6 @@ from aerostat_gym.agents.frontier import (
     swing_response,
     swing_response_dwell,
 )
-from aerostat_gym.agents.lqr import OBS_STATE_OFFSET, OBS_WIND_INDEX
 from aerostat_gym.agents.metrics import fit_damped_sinusoid
 from aerostat_gym.agents.modal import (
     ModalPolicy,
@@ -32,6 +31,7 @@ from aerostat_gym.agents.modal import (
     design_modal,
     pendulum_target,
 )
+from aerostat_gym.envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
 from aerostat_gym.params import load_params
 
 DT = 0.2
@@ -107,11 +107,11 @@ def test_schedule_and_policy(params):
     pol = ModalPolicy(params, dt=DT, schedule=sch)
     d = sch.designs[0]
     lay = d.lqr.linear.layout
-    obs = np.zeros(OBS_STATE_OFFSET + lay.size, np.float32)
-    obs[OBS_WIND_INDEX] = 10.0
-    obs[OBS_STATE_OFFSET + lay.cm_pos.start] = 2.0
+    obs = np.zeros(OBS_FULL_STATE + lay.size, np.float32)
+    obs[OBS_FULL_WIND] = 10.0
+    obs[OBS_FULL_STATE + lay.cm_pos.start] = 2.0
     a, _ = pol.predict(obs)
-    assert a[0] == pytest.approx(d.command(obs[OBS_STATE_OFFSET:].astype(float))
+    assert a[0] == pytest.approx(d.command(obs[OBS_FULL_STATE:].astype(float))
                                  / params.winch.max_speed, abs=1e-6)
 
 

@@ -5,11 +5,11 @@ evaluation of the new baselines. Every assertion states its tolerance.
 import numpy as np
 import pytest
 
-from aerostat_gym.agents.classical import load_classical
 from aerostat_gym.agents.evaluate import episode_metrics, run_scenario
 from aerostat_gym.agents.frontier import swing_response
 from aerostat_gym.agents.lqg import LQGPolicy, LQGSchedule
 from aerostat_gym.agents.modal import ModalPolicy, ModalSchedule
+from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.agents.protocol_stats import bootstrap_mean_ci, paired_difference_ci
 from aerostat_gym.agents.protocol_table import aggregate_table, cell_table, markdown
 from aerostat_gym.params import load_params
@@ -75,7 +75,12 @@ def test_seeded_swing_bit_identical_smoke():
     assert not np.array_equal(a.set_point, c.set_point)
 
 
-def test_load_classical_names():
-    """Unknown names are refused with the known ones listed."""
+def test_policy_names_include_the_model_based_baselines():
+    """modal and lqg load by name; an unknown name is refused with the known ones listed."""
+    from aerostat_gym.agents.lqg import LQGPolicy
+    from aerostat_gym.agents.modal import ModalPolicy
+
+    assert isinstance(load_policy("modal"), ModalPolicy)
+    assert isinstance(load_policy("lqg", obs_noise=0.01), LQGPolicy)
     with pytest.raises(ValueError, match="modal"):
-        load_classical("pid")
+        load_policy("pid")

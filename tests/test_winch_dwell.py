@@ -11,8 +11,8 @@ import pytest
 from aerostat_gym.agents.frontier import swing_response, swing_response_dwell
 from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule
 from aerostat_gym.params import load_params
-from aerostat_gym.winch import brake_rule
-from aerostat_gym.winch_dwell import DwellBrake, dwell_brake_rule
+from aerostat_gym.sim.winch import brake_rule
+from aerostat_gym.sim.winch_dwell import DwellBrake, dwell_brake_rule
 
 VMAX, BAND, HOLD, DT = 1.0, 0.02, 0.02, 0.2
 

@@ -25,12 +25,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import apply_overrides, load_params
-from ..simulation import simulate
-from ..winch_dwell import DEFAULT_DWELL_TIME, DEFAULT_STANDSTILL_BAND, DwellBrake
+from ..sim import simulate
+from ..sim.winch_dwell import DEFAULT_DWELL_TIME, DEFAULT_STANDSTILL_BAND, DwellBrake
 from .evaluate import policy_obs
-from .lqr import OBS_STATE_OFFSET, OBS_WIND_INDEX
 from .metrics import fit_damped_sinusoid
 from .metrics_drift import fit_pendulum_with_drift
 from .modal import design_modal
@@ -156,7 +156,7 @@ def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: floa
     ix, iL, iv = lay.cm_pos.start, lay.winch_length, lay.winch_speed
     steps = env.max_episode_steps
     x, L, v, sp = (np.zeros(steps + 1) for _ in range(4))
-    x[0], L[0], v[0] = (b.X[0, ix] - b.XT[0, ix], b.X[0, iL] - b.XT[0, iL], b.X[0, iv])
+    x[0], L[0], v[0] = (b.state[0, ix] - b.trim_state[0, ix], b.state[0, iL] - b.trim_state[0, iL], b.state[0, iv])
     state, start, ended, k_end = None, np.ones(1, bool), None, steps
     for k in range(1, steps + 1):
         action, state = policy.predict(policy_obs(policy, obs), state=state, episode_start=start,
@@ -165,7 +165,7 @@ def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: floa
         a = np.asarray(action, np.float32).reshape(-1, 1)
         sp[k - 1] = float(np.clip(a[0, 0], -1.0, 1.0)) * vmax
         obs, _, term, trunc, info = env.step(a)
-        x[k], L[k], v[k] = (b.X[0, ix] - b.XT[0, ix], b.X[0, iL] - b.XT[0, iL], b.X[0, iv])
+        x[k], L[k], v[k] = (b.state[0, ix] - b.trim_state[0, ix], b.state[0, iL] - b.trim_state[0, iL], b.state[0, iv])
         if term[0]:
             ended, k_end = str(info["termination"][0]), k
             break
@@ -181,7 +181,7 @@ def initial_state(wind_speed: float, swing: float, params=None) -> tuple[np.ndar
     """(x0, x_trim): the environment's start of a swing-recovery run and its trim (6n+8)."""
     env = swing_env(wind_speed, swing, params=params)
     env.reset(seed=[0], options={"wind_speed": [wind_speed]})
-    x0, xt = env.batch.X[0].copy(), env.batch.XT[0].copy()
+    x0, xt = env.batch.state[0].copy(), env.batch.trim_state[0].copy()
     env.close()
     return x0, xt
 
@@ -237,8 +237,8 @@ def swing_response_dwell(policy, wind_speed: float, swing: float, *,
     def u(t, x):
         dx = x - xt
         dx[i_psi] = (dx[i_psi] + np.pi) % (2.0 * np.pi) - np.pi
-        obs = np.zeros(OBS_STATE_OFFSET + lay_size)
-        obs[OBS_WIND_INDEX], obs[OBS_STATE_OFFSET:] = wind_speed, dx
+        obs = np.zeros(OBS_FULL_STATE + lay_size)
+        obs[OBS_FULL_WIND], obs[OBS_FULL_STATE:] = wind_speed, dx
         a, memo["state"] = policy.predict(obs, memo["state"], memo["start"])
         memo["start"][:] = False
         v = float(np.clip(a[0], -1.0, 1.0)) * vmax

@@ -44,8 +44,8 @@ from ..analysis.linear import state_steps
 from ..analysis.trim import find_equilibrium
 from ..envs.spaces import CHANNELS, N_OBS
 from ..params import Params
-from ..physics.layout import StateLayout
-from ..simulation import Model
+from ..physics.state import StateLayout
+from ..sim import Model
 from .lqr import DEFAULT_SPEEDS, LQRDesign, design_lqr, discretize
 
 #: Standard observation channels the filter uses (name -> index), all longitudinal.

@@ -22,10 +22,12 @@ from ..analysis.reference import reference_periods
 from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION
 from ..params import Params, load_params
 from ..resources import SHIPPED_POLICY, shipped_path
+from .lqg import LQGPolicy
 from .lqr import LQRPolicy
+from .modal import ModalPolicy
 from .sb3io import PolicyError, as_batch, load_sb3, to_actions
 
-BASELINES = ("passive", "tension", "lqr")
+BASELINES = ("passive", "tension", "lqr", "modal", "lqg")
 #: Names of trained policies that ship with the package.
 SHIPPED = {"shipped": SHIPPED_POLICY}
 #: Tension feedback in units of the configuration: reel speed per tension excess, as a fraction
@@ -88,10 +90,16 @@ class TensionFeedbackPolicy:
         return to_actions(v / self.max_speed, single), state
 
 
-def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None):
-    """A baseline by name ('passive', 'tension', 'lqr') designed for ``params`` (default: the
-    baseline) and the wind range (for the LQR schedule), a shipped trained policy by name
-    ('shipped': the package's default PPO policy) or a saved SB3 model (.zip path)."""
+def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
+                obs_noise: float = 0.0):
+    """A baseline by name designed for ``params`` (default: the baseline), a shipped trained
+    policy by name ('shipped': the package's default PPO policy) or a saved SB3 model (.zip).
+
+    Baselines: 'passive' (braked winch), 'tension' (tension feedback), 'lqr' (gain-scheduled
+    LQR over the wind range, privileged full state), 'modal' (pendulum pole placement,
+    privileged full state), 'lqg' (Kalman filter on the standard channels designed for the
+    sensor noise ``obs_noise``, with the LQR gains).
+    """
     params = params or load_params()
     if name == "passive":
         return PassivePolicy()
@@ -99,6 +107,10 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None):
         return TensionFeedbackPolicy.for_params(params)
     if name == "lqr":
         return LQRPolicy(params, dt=dt, wind_range=wind_range)
+    if name == "modal":
+        return ModalPolicy(params, dt=dt)
+    if name == "lqg":
+        return LQGPolicy(params, dt=dt, obs_noise=obs_noise)
     if name in SHIPPED:
         return load_sb3(shipped_path(SHIPPED[name]))
     if name.endswith(".zip") or Path(name).exists():

@@ -22,8 +22,8 @@ from ..scale.mc_report import summarize, write_outputs
 from ..scale.montecarlo import PERIOD_KEYS, SWEEP_SPEEDS, evaluate_sample, run_ray, run_serial
 from ..scale.ranges import RANGE_SOURCES, estimated_ranges
 from ..scale.tune import add_tune_arguments, run_tune_command
-from .stability import stability_params as params_from_args
 from .stability import parse_speeds
+from .stability import stability_params as params_from_args
 
 
 def add_montecarlo_parser(sub) -> None:

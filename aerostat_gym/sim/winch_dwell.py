@@ -1,5 +1,5 @@
 """Dwell-time brake logic for the ground winch (a proposal; the environment still uses
-:func:`aerostat_gym.winch.brake_rule`).
+:func:`aerostat_gym.sim.winch.brake_rule`).
 
 The shipped rule engages the brake at every control step whose set-point is below
 ``winch.brake_speed`` (0.02 m/s). A linear controller's command passes through that band twice
@@ -20,7 +20,7 @@ speed loop decelerates the drum with set-point 0. The default dwell, 10 s, is a 
 pendulum period (36-45 s over 5-15 m/s): a command that crosses zero on its way to the other
 sign never trips it, while a command that has settled engages the brake within 10 s.
 
-With ``dwell = 0`` the rule is the shipped :func:`aerostat_gym.winch.brake_rule` step for step.
+With ``dwell = 0`` the rule is the shipped :func:`aerostat_gym.sim.winch.brake_rule` step for step.
 """
 
 from __future__ import annotations
