@@ -34,7 +34,7 @@ from aerostat_gym.scale.montecarlo import (
     studies_identical,
 )
 from aerostat_gym.scale.ranges import ParameterRange, estimated_ranges, range_disagreements
-from aerostat_gym.scale.stats import bootstrap_ci, point_biserial, wilson_interval
+from aerostat_gym.scale.stats import point_biserial, wilson_interval
 from aerostat_gym.scale.tune import TuneSpaceError, apply_sample, config_table, load_space
 
 BASE = load_params()
@@ -131,17 +131,6 @@ def test_point_biserial_matches_scipy_and_closed_form():
     closed = (x[y == 1].mean() - x[y == 0].mean()) / x.std() * math.sqrt(p * (1 - p))
     assert point_biserial(x, y) == pytest.approx(closed, rel=1e-12)
     assert math.isnan(point_biserial(x, np.zeros_like(x)))
-
-
-def test_bootstrap_ci_matches_normal_theory():
-    x = np.random.default_rng(0).normal(5.0, 2.0, size=400)
-    lo, hi = bootstrap_ci(x, n_boot=20_000)
-    half = 1.959964 * x.std(ddof=0) / math.sqrt(x.size)
-    assert (hi - lo) / 2 == pytest.approx(half, rel=0.05)
-    assert (lo + hi) / 2 == pytest.approx(x.mean(), abs=0.05 * half)
-    assert bootstrap_ci([3.0, 3.0, 3.0]) == (3.0, 3.0)
-    with pytest.raises(ValueError, match="non-empty finite sample"):
-        bootstrap_ci([])
 
 
 def _synthetic_study(n: int = 10) -> Study:

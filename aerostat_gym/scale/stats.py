@@ -1,5 +1,6 @@
-"""Small statistics used by the study reports: percentile bootstrap confidence intervals,
-correlation of a parameter with an outcome, and the Wilson interval of a probability."""
+"""Small statistics used by the Monte Carlo study reports: correlation of a parameter with an
+outcome and the Wilson interval of a probability (bootstrap intervals of means come from
+:mod:`aerostat_gym.agents.protocol_stats`)."""
 
 from __future__ import annotations
 
@@ -10,41 +11,6 @@ from scipy import stats
 
 #: Two-sided 95 % normal quantile.
 Z95 = 1.959963984540054
-
-
-def bootstrap_ci(data, level: float = 0.95, n_boot: int = 10_000,
-                 seed: int = 0) -> tuple[float, float]:
-    """Percentile bootstrap confidence interval of the mean.
-
-    Parameters
-    ----------
-    data : 1-D sample (e.g. one score per training seed).
-    level : coverage of the interval.
-    n_boot : bootstrap resamples.
-    seed : seed of the resampling generator (the interval is reproducible).
-
-    Returns
-    -------
-    (low, high); (x, x) for a single value.
-
-    Notes
-    -----
-    Resamples of size n are drawn with replacement, their means sorted, and the
-    (1 - level) / 2 and (1 + level) / 2 quantiles returned. With few seeds (5-10) the
-    percentile interval is somewhat narrower than nominal coverage; it is what rliable-style
-    reports use and is stated as such.
-    """
-    x = np.asarray(data, float).ravel()
-    if x.size == 0 or not np.all(np.isfinite(x)):
-        raise ValueError(f"bootstrap_ci needs a non-empty finite sample, got {x.tolist()}")
-    if not 0 < level < 1:
-        raise ValueError(f"level must be in (0, 1), got {level!r}")
-    if x.size == 1:
-        return float(x[0]), float(x[0])
-    rng = np.random.default_rng(seed)
-    means = x[rng.integers(0, x.size, size=(n_boot, x.size))].mean(axis=1)
-    lo, hi = np.quantile(means, [(1 - level) / 2, (1 + level) / 2])
-    return float(lo), float(hi)
 
 
 def wilson_interval(successes: int, n: int) -> tuple[float, float]:

@@ -36,11 +36,11 @@ from pathlib import Path
 import numba
 import numpy as np
 
+from ..agents.protocol_stats import bootstrap_mean_ci
 from ..agents.sb3io import vecnormalize_path
 from ..agents.train import ALGOS, PROJECT_BLOCK, load_hyperparams, train
 from .cluster import start_ray, stop_ray
 from .extra import require
-from .stats import bootstrap_ci
 
 KINDS = ("uniform", "loguniform", "randint", "quniform", "choice")
 SEARCHERS = ("optuna", "random")
@@ -403,11 +403,20 @@ def config_table(trials: list[dict], n_boot: int = 10_000) -> list[dict]:
         row = {"config": cfg, "seeds": sorted(t["seed"] for t in ts), "n_seeds": len(ts)}
         for name in ("final_score", "best_score"):
             x = np.array([t[name] for t in ts])
-            lo, hi = bootstrap_ci(x, n_boot=n_boot)
+            lo, hi = _seed_interval(x, n_boot)
             row.update({f"{name}_mean": float(x.mean()), f"{name}_ci95_low": lo,
                         f"{name}_ci95_high": hi})
         rows.append(row)
     return sorted(rows, key=lambda r: -r["final_score_mean"])
+
+
+def _seed_interval(x: np.ndarray, resamples: int) -> tuple[float, float]:
+    """95 % percentile-bootstrap interval of the mean over seeds (the rliable-style interval
+    of the protocol statistics); a single seed gives the point itself."""
+    if x.size == 1:
+        return float(x[0]), float(x[0])
+    ci = bootstrap_mean_ci(x, resamples=resamples, method="percentile")
+    return ci.low, ci.high
 
 
 def _copy_best(trials: list[dict], table: list[dict], setup: TrialSetup, out: Path) -> dict:
