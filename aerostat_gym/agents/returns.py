@@ -68,6 +68,8 @@ def format_returns(rows: list, reference: str = "passive") -> str:
     for r in rows:
         lo, hi = r["return_ci"]
         dlo, dhi = r[key + "_ci"]
+        diff = "(reference)" if r["policy"] == reference else \
+            f"{r[key]:+.1f} [{dlo:+.1f}, {dhi:+.1f}]"
         lines.append(f"| `{r['task']}` | {r['policy']} | {r['return']:.1f} [{lo:.1f}, {hi:.1f}] "
-                     f"| {r[key]:+.1f} [{dlo:+.1f}, {dhi:+.1f}] |")
+                     f"| {diff} |")
     return "\n".join(lines)
