@@ -447,6 +447,15 @@ class LQRSchedule:
 
     def __init__(self, params: Params, speeds=None, dt: float = 0.2,
                  weights: dict | None = None, *, subset: str = "auto"):
+        designs = self._build(params, speeds, dt, lambda U, eq: design_lqr(
+            params, U, dt, weights, equilibrium=eq, subset=subset))
+        self.weights = designs[0].weights
+        self.subsets = [d.subset for d in designs]
+
+    def _build(self, params: Params, speeds, dt: float, design_at) -> list:
+        """Design at every speed (``design_at(U, equilibrium)``, trims by continuation in U)
+        and fill the tables; returns the designs. Subclasses with another design rule (the
+        modal controller) reuse it."""
         speeds = np.asarray(DEFAULT_SPEEDS if speeds is None else speeds, float).ravel()
         if speeds.size == 0 or np.any(np.diff(speeds) <= 0) or np.any(speeds < 0):
             raise ValueError(f"speeds must be non-negative and strictly increasing, got {speeds}")
@@ -454,15 +463,12 @@ class LQRSchedule:
         designs, eq = [], None
         for U in speeds:
             eq = find_equilibrium(params, float(U), guess=eq)
-            designs.append(design_lqr(params, float(U), dt, weights, equilibrium=eq,
-                                      subset=subset))
+            designs.append(design_at(float(U), eq))
         self.build_time_s = time.perf_counter() - t0
         self.params = params
         self.fingerprint = params_fingerprint(params)
         self.speeds = speeds
         self.dt = float(dt)
-        self.weights = designs[0].weights
-        self.subsets = [d.subset for d in designs]
         self.gains = np.array([d.K for d in designs])
         self.trims = np.array([d.x_trim for d in designs])
         self.pendulum_zeta = np.array([[d.summary()["pendulum"][k]["zeta"] for k in ("open", "closed")]
@@ -470,6 +476,7 @@ class LQRSchedule:
         self.pitch_zeta = np.array([[d.summary()["pitching"][k]["zeta"] for k in ("open", "closed")]
                                     for d in designs])
         self.designs = designs
+        return designs
 
     # --- lookup -----------------------------------------------------------------------------
 

@@ -31,7 +31,6 @@ like :class:`aerostat_gym.agents.lqr.LQRSchedule`, whose lookup and policy it re
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,13 +39,11 @@ from scipy.optimize import linear_sum_assignment
 from ..analysis.trim import Equilibrium, find_equilibrium
 from ..params import Params
 from .lqr import (
-    DEFAULT_SPEEDS,
     LQRDesign,
     LQRPolicy,
     LQRSchedule,
     design_lqr,
     discretize,
-    params_fingerprint,
 )
 
 #: Time constant of the length-restoring loop [s] (the pole the winch's neutral length mode is
@@ -318,33 +315,14 @@ class ModalSchedule(LQRSchedule):
 
     def __init__(self, params: Params, speeds=None, dt: float = 0.2, zeta=None, *,
                  wn_factor: float = 1.0, length_time: float = DEFAULT_LENGTH_TIME):
-        speeds = np.asarray(DEFAULT_SPEEDS if speeds is None else speeds, float).ravel()
-        if speeds.size == 0 or np.any(np.diff(speeds) <= 0) or np.any(speeds < 0):
-            raise ValueError(f"speeds must be non-negative and strictly increasing, got {speeds}")
         target = zeta if callable(zeta) else (default_zeta if zeta is None
                                               else (lambda _u: float(zeta)))
-        t0 = time.perf_counter()
-        designs, eq = [], None
-        for U in speeds:
-            eq = find_equilibrium(params, float(U), guess=eq)
-            designs.append(design_modal(params, float(U), target(float(U)), dt,
-                                        wn_factor=wn_factor, length_time=length_time,
-                                        equilibrium=eq))
-        self.build_time_s = time.perf_counter() - t0
-        self.params = params
-        self.fingerprint = params_fingerprint(params)
-        self.speeds = speeds
-        self.dt = float(dt)
+        designs = self._build(params, speeds, dt, lambda U, eq: design_modal(
+            params, U, target(U), dt, wn_factor=wn_factor, length_time=length_time,
+            equilibrium=eq))
         self.weights = {"zeta": [d.zeta for d in designs], "wn_factor": float(wn_factor),
                         "length_time": float(length_time)}
         self.subsets = ["long"] * len(designs)
-        self.gains = np.array([d.K for d in designs])
-        self.trims = np.array([d.x_trim for d in designs])
-        self.pendulum_zeta = np.array([[d.summary()["pendulum"][k]["zeta"]
-                                        for k in ("open", "closed")] for d in designs])
-        self.pitch_zeta = np.array([[d.summary()["pitching"][k]["zeta"]
-                                     for k in ("open", "closed")] for d in designs])
-        self.designs = designs
 
 
 class ModalPolicy(LQRPolicy):
