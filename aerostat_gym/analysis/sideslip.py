@@ -13,18 +13,29 @@ from ..physics.core import rotation_matrix
 from ..sim import Model
 from .trim import find_equilibrium
 
-OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 80, 100)
+OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 75, 90)
 WIND = [OBS_WIND_X, OBS_WIND_Y, OBS_WIND_Z]  # measured air velocity at the CM
 
 
-def yaw_curve(stall_deg: float, wind_speed: float = 8.0) -> list[float]:
-    """Yaw acceleration dr/dt [rad/s^2] at the trim with psi offset by each of OFFSETS_DEG."""
-    p = load_params().replace(**{"fins.alpha_stall_deg": stall_deg})
+def yaw_curve(wind_speed: float = 8.0, overrides: dict | None = None,
+              offsets=OFFSETS_DEG) -> list[float]:
+    """Static yaw acceleration dr/dt [rad/s^2] at the trim with psi offset by each yaw offset.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Uniform wind speed [m/s] of the trim.
+    overrides : dict, optional
+        Parameter overrides (dotted keys, e.g. ``{"fins.post_stall": "flat"}``).
+    offsets : sequence of float
+        Yaw offsets from the trim heading [deg]; negative results restore.
+    """
+    p = load_params(overrides=overrides)
     eq = find_equilibrium(p, wind_speed)
     model = Model(p, wind=wind_speed)
     lay = model.layout
     out = []
-    for deg in OFFSETS_DEG:
+    for deg in offsets:
         x = eq.x.copy()
         x[lay.euler.start + 2] += np.radians(deg)
         out.append(float(model.rhs(x)[lay.rates.start + 2]))
