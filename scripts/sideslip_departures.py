@@ -1,12 +1,13 @@
-"""Measure the yaw departures described in the README ("Known limitation: yaw departures at
-large sideslip").
+"""Measure the yaw departures at large sideslip (README, issue 13).
 
-Usage: python scripts/sideslip_departures.py [--episodes 20] [--stall 16 45]
+Usage: python scripts/sideslip_departures.py [--episodes 20]
 
-Prints (1) the static yaw acceleration against a yaw offset from the trim at 8 m/s (negative:
-restoring) for each fin stall angle given, and (2) for the turbulence presets light and
-moderate at 3, 5, 10 and 15 m/s, the number of passive-winch episodes (120 s, seeds 100 ...)
-in which the sideslip at the aerostat CM exceeds 30 degrees.
+Prints (1) the static yaw acceleration against a yaw offset from the trim at 5, 10 and 15 m/s
+(negative: restoring) for the baseline fins (Viterna-Corrigan post-stall, 45 deg stall) and for
+[LN02]'s flat post-stall lift at the 2-D stall angle (16 deg), and (2) for the wind-scaled
+intensity classes light, moderate and severe at 3, 5, 10 and 15 m/s, the number of
+passive-winch episodes (120 s, seeds 100 ...) in which the sideslip at the aerostat CM
+exceeds 30 degrees.
 """
 
 from __future__ import annotations
@@ -15,18 +16,22 @@ import argparse
 
 from aerostat_gym.analysis.sideslip import OFFSETS_DEG, max_sideslip, yaw_curve
 
+FINS = {"viterna, 45 deg": None,
+        "flat, 16 deg": {"fins.post_stall": "flat", "fins.alpha_stall_deg": 16.0}}
+
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--episodes", type=int, default=20)
-    ap.add_argument("--stall", type=float, nargs="+", default=[16.0, 45.0])
     args = ap.parse_args(argv)
-    print("static yaw acceleration [rad/s^2] at 8 m/s against the yaw offset [deg]:")
-    print("  stall " + "".join(f"{d:>8d}" for d in OFFSETS_DEG))
-    for stall in args.stall:
-        print(f"  {stall:5.0f} " + "".join(f"{v:+8.3f}" for v in yaw_curve(stall)))
-    print(f"passive episodes with sideslip > 30 deg (of {args.episodes}):")
-    for turb in ("light", "moderate"):
+    print("static yaw acceleration [rad/s^2] against the yaw offset [deg]:")
+    print("  fins             U m/s" + "".join(f"{d:>8d}" for d in OFFSETS_DEG))
+    for name, over in FINS.items():
+        for u in (5.0, 10.0, 15.0):
+            curve = yaw_curve(u, over)
+            print(f"  {name:16s} {u:5.0f} " + "".join(f"{v:+8.3f}" for v in curve))
+    print(f"passive episodes with sideslip > 30 deg at the CM (of {args.episodes}, 120 s):")
+    for turb in ("light", "moderate", "severe"):
         counts = "".join(f"  {u:g} m/s: {int((max_sideslip(turb, u, args.episodes) > 30.0).sum()):2d}"
                          for u in (3.0, 5.0, 10.0, 15.0))
         print(f"  {turb:9s}{counts}")

@@ -22,6 +22,7 @@ from .episodes import (
     DEFAULT_HORIZON,
     TrimTable,
     field_length_needed,
+    normalise_bank,
     sample_episode,
     turbulence_bank,
 )
@@ -86,8 +87,8 @@ class EnvBatch:
         u_max = self.trims.speeds[-1] * _advection_factor(self.params, turb)
         need = field_length_needed(turb, u_max, self.horizon)
         # unit-variance fields, scaled per episode to its mean wind (episodes._intensity)
-        return turbulence_bank(turb.unit(), self.task.wind_bank_size, self.task.wind_bank_seed,
-                               need)
+        return normalise_bank(turbulence_bank(turb.unit(), self.task.wind_bank_size,
+                                              self.task.wind_bank_seed, need))
 
     def __getstate__(self):  # the trims and the bank are rebuilt (or found in the cache)
         d = dict(self.__dict__)

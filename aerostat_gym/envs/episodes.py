@@ -181,6 +181,22 @@ def _field(cfg, bank_shape, ua, horizon, wp, rng) -> tuple[int, float]:
 # --- per-episode turbulence intensity (issue 13) -------------------------------------------------
 
 
+def normalise_bank(bank: np.ndarray) -> np.ndarray:
+    """Scale every field of a bank, per height row and component, to unit mean square, in
+    place (idempotent); returns the bank.
+
+    A Veers field's variance is itself random (Gaussian Fourier coefficients: the eight fields
+    of the default bank range 0.46-1.40 in variance). Scaling a row by a constant leaves its
+    spectral shape and its coherence with every other row unchanged, so the fields stay valid
+    samples of the spectrum, and each episode's sigma is then the one its class asks for.
+    """
+    if bank.shape[2] == 0:
+        return bank
+    rms = np.sqrt(np.mean(bank * bank, axis=2, keepdims=True))
+    np.divide(bank, np.where(rms > 0.0, rms, 1.0), out=bank)
+    return bank
+
+
 def _intensity(cfg: TurbulenceConfig, wp: np.ndarray) -> tuple[float, float, float]:
     """Scale the bank's unit-variance field to this episode's mean wind (in place in wp) and
     return (sigma_u, sigma_v, sigma_w) [m/s]: the class's sigmas at the episode's U(h) for a

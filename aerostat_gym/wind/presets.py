@@ -258,8 +258,9 @@ class TurbulenceConfig:
         return self.z_min, self.dz, n
 
     def replace(self, **changes) -> TurbulenceConfig:
-        """Copy with fields replaced (validated again)."""
-        return dataclasses.replace(self, **changes)
+        """Copy with fields replaced (validated again). Explicit sigma_* without an
+        ``intensity_model`` make the copy 'fixed' (a measured site's values)."""
+        return dataclasses.replace(self, **_explicit_sigmas(changes))
 
     @classmethod
     def from_mil(cls, severity: str | float, height: float = 300.0, model: str = "von_karman",
@@ -321,13 +322,19 @@ def _from_dict(d: dict) -> TurbulenceConfig:
     """Config from a dict; key 'preset' picks the base, other keys override its fields."""
     d = dict(d)
     base = get_preset(d.pop("preset", "none"))
-    if any(k in d for k in ("sigma_u", "sigma_v", "sigma_w")) and "intensity_model" not in d:
-        d["intensity_model"] = "fixed"  # explicit sigmas: a measured site
     known = {f.name for f in fields(TurbulenceConfig)}
     unknown = sorted(set(d) - known)
     if unknown:
         raise ValueError(f"unknown turbulence field(s) {unknown}; known: {sorted(known)}")
     return base.replace(**d)
+
+
+def _explicit_sigmas(changes: dict) -> dict:
+    """``changes`` with intensity_model 'fixed' added when it sets a sigma but no model."""
+    if any(k in changes for k in ("sigma_u", "sigma_v", "sigma_w")) and \
+            "intensity_model" not in changes:
+        return {**changes, "intensity_model": "fixed"}
+    return changes
 
 
 def describe(cfg: TurbulenceConfig) -> list[dict]:
