@@ -7,12 +7,19 @@ import pytest
 
 from aerostat_gym.analysis.intensity import realised_intensity
 from aerostat_gym.analysis.sideslip import yaw_curve
+from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.params import load_params
-from aerostat_gym.physics.core import _hull, fin_coefficients, rhs
-from aerostat_gym.physics.packing import P_AIRINERTIA, pack_params
+from aerostat_gym.physics.core import _hull, fin_coefficients, rhs, rotation_matrix
+from aerostat_gym.physics.packing import P_AIRINERTIA, P_POSTSTALL, pack_params
 from aerostat_gym.physics.state import StateLayout, work_size
-from aerostat_gym.physics.wind import air_acceleration, pack_wind, set_advection, set_field
-from aerostat_gym.wind.presets import PRESETS, TurbulenceConfig
+from aerostat_gym.physics.wind import (
+    NO_FIELD,
+    air_acceleration,
+    pack_wind,
+    set_advection,
+    set_field,
+)
+from aerostat_gym.wind.presets import PRESETS, TurbulenceConfig, resolve_turbulence
 
 FT = 0.3048
 
@@ -66,8 +73,6 @@ def test_class_targets_in_source_bands():
 def test_explicit_sigmas_stay_available():
     """A measured site's sigmas: a dict with sigma_* becomes a 'fixed' config and is used as
     given at every wind; sigmas on a wind-scaled model are a ValueError naming the field."""
-    from aerostat_gym.wind.presets import resolve_turbulence
-
     cfg = resolve_turbulence({"preset": "moderate", "sigma_u": 1.2, "sigma_v": 0.9, "sigma_w": 0.6})
     assert cfg.intensity_model == "fixed"
     assert cfg.for_wind(pack_wind("uniform", 13.0)).sigmas == (1.2, 0.9, 0.6)
@@ -110,7 +115,7 @@ def test_fin_linear_regime_is_the_papers(packed):
     """Below stall the fin is [LN02]'s: C_L = a alpha, C_D = C_D0 + k (a alpha)^2, identical
     (to 1e-15) to the flat post-stall option."""
     flat = packed.copy()
-    flat[137] = 0.0  # P_POSTSTALL
+    flat[P_POSTSTALL] = 0.0
     for deg in (-40.0, -10.0, 0.0, 3.0, 20.0, 44.9):
         a = math.radians(deg)
         assert fin_coefficients(a, packed) == pytest.approx(fin_coefficients(a, flat), abs=1e-15)
@@ -185,13 +190,16 @@ def _accelerating_air(a, direction_deg=30.0):
 
 def test_air_acceleration_of_linear_field():
     """The sampled air acceleration of a field linear in time is that slope, rotated from
-    mean-wind axes (direction 30 deg) to inertial, to 1e-12."""
+    mean-wind axes (direction 30 deg) to inertial, to 1e-12, with or without the average over
+    an 18 m hull length."""
     a = (0.7, -0.4, 0.25)
     wp, wf = _accelerating_air(a)
     c, s = math.cos(math.radians(30.0)), math.sin(math.radians(30.0))
     want = (c * a[0] - s * a[1], s * a[0] + c * a[1], a[2])
     for t in (0.0, 3.33, 17.05):
-        assert air_acceleration(-40.0, 12.0, 305.0, t, wp, wf) == pytest.approx(want, abs=1e-12)
+        for length in (0.0, 18.0):
+            got = air_acceleration(-40.0, 12.0, 305.0, t, wp, wf, length)
+            assert got == pytest.approx(want, abs=1e-12)
 
 
 def test_air_inertia_closed_form():
@@ -202,9 +210,6 @@ def test_air_inertia_closed_form():
     prm = load_params()
     n = prm.tether.n_elements
     lay = StateLayout(n)
-    from aerostat_gym.analysis.trim import find_equilibrium
-    from aerostat_gym.physics.core import rotation_matrix
-
     x = find_equilibrium(prm, 6.0).x.copy()
     x[lay.euler] = (0.05, -0.2, 2.5)  # an arbitrary attitude
     x[lay.cm_vel] = 0.0
@@ -239,13 +244,9 @@ def test_air_inertia_vanishes_in_steady_wind():
     prm = load_params()
     n = prm.tether.n_elements
     lay = StateLayout(n)
-    from aerostat_gym.analysis.trim import find_equilibrium
-
     x = find_equilibrium(prm, 8.0).x.copy()
     x[lay.cm_vel] = (0.3, -0.2, 0.1)
     wp = pack_wind("uniform", 8.0)
-    from aerostat_gym.physics.wind import NO_FIELD
-
     res = []
     for on in (1.0, 0.0):
         p = pack_params(prm)

@@ -61,27 +61,42 @@ def realised_intensity(turbulence, wind_speed: float, episodes: int = 20,
 
 
 def air_inertia_force(wp: np.ndarray, wf: np.ndarray, point, rho_volume: float,
-                      k_axial: float, k_lateral: float, duration: float,
+                      k_axial: float, k_lateral: float, length: float, duration: float,
                       dt: float = SAMPLE_DT) -> dict:
     """RMS and peak air-inertia force [N] on a hull held at ``point`` with its axis along the
-    mean wind: (1 + k1) rho V a_u along the axis, (1 + k3) rho V a_v, a_w across it.
+    mean wind: (1 + k1) rho V a_u along the axis, (1 + k3) rho V a_v, a_w across it, with
+    a the air acceleration averaged over the hull length.
 
     Parameters
     ----------
-    wp, wf : ndarray
-        Wind vector and turbulence field (:func:`aerostat_gym.wind.build_wind`).
+    wp : ndarray
+        Wind-parameter vector (:func:`aerostat_gym.wind.build_wind`).
+    wf : ndarray
+        Turbulence field of that wind.
     point : (float, float, float)
         Inertial position of the hull's centre of buoyancy [m].
     rho_volume : float
         Displaced air mass rho V [kg].
-    k_axial, k_lateral : float
-        Added-mass coefficients k1 (axial) and k3 (lateral) [-].
+    k_axial : float
+        Axial added-mass coefficient k1 [-].
+    k_lateral : float
+        Lateral added-mass coefficient k3 [-].
+    length : float
+        Hull length [m]: the air acceleration is averaged over it along the wind.
     duration : float
-        Record length [s]. dt : sampling step [s].
+        Record length [s].
+    dt : float
+        Sampling step [s].
+
+    Returns
+    -------
+    dict
+        RMS force along, across and normal to the wind [N], peak force magnitude [N] and the
+        RMS air acceleration [m/s^2].
     """
     x, y, z = point
     times = np.arange(0.0, duration, dt)
-    a = np.array([air_acceleration(x, y, z, t, wp, wf) for t in times])
+    a = np.array([air_acceleration(x, y, z, t, wp, wf, length) for t in times])
     c, s = wp[W_DIRC], wp[W_DIRS]
     au = a[:, 0] * c + a[:, 1] * s  # along the mean wind: the hull axis
     av = -a[:, 0] * s + a[:, 1] * c

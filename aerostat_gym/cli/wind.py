@@ -102,7 +102,7 @@ def _air_inertia(cfg, wp, wf, duration: float) -> dict:
     p = load_params()
     a = p.aerostat
     return air_inertia_force(wp, wf, (0.0, 0.0, cfg.reference_height),
-                             p.environment.rho_air * a.volume, a.k1, a.k3, duration)
+                             p.environment.rho_air * a.volume, a.k1, a.k3, a.length, duration)
 
 
 def _table(out: dict) -> str:

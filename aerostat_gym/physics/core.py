@@ -29,7 +29,8 @@ Model ([LN02]; equations reconstructed in docs/parameters.md section 4)
 - Air inertia: in accelerating air (turbulence, gusts) the hull feels the Froude-Krylov force
   rho V dW/dt plus the added-mass force k_i rho V dW_i/dt per body axis, applied at the
   centre of buoyancy (:func:`_air_inertia`); dW/dt is the local time derivative at the hull
-  point (:func:`aerostat_gym.physics.wind.air_acceleration`). Zero in steady wind.
+  point averaged over the hull length along the wind
+  (:func:`aerostat_gym.physics.wind.air_acceleration`). Zero in steady wind.
 - Inertia: translational added mass m_e = m + k rho V per body axis. The inertial terms use
   Kirchhoff's form M_e dV/dt + omega x (M_e V) = F and I domega/dt + omega x I omega
   + V x (M_a V) = M with V the ground-relative CM velocity. This is the rigid-body mechanics of
@@ -50,6 +51,7 @@ from numba import njit
 
 from .packing import (
     P_AF,
+    P_AILEN,
     P_AIRINERTIA,
     P_ANCHOR,
     P_ASTALL,
@@ -596,12 +598,13 @@ def _aero_loads(t, x, p, wp, wf, w, R, o):
 def _air_inertia(t, px, py, pz, p, R, wp, wf):
     """Body-frame force of accelerating air on the hull at inertial point (px, py, pz).
 
-    The pressure gradient that accelerates the air at a = dW/dt pushes the displaced volume
-    with rho V a (Froude-Krylov); the air the hull must accelerate with it adds k_i rho V a_i
-    along body axis i (added mass; the body's own acceleration is in the effective mass). In
-    total F_i = (rho V + m_a,i) a_i = (1 + k_i) rho V a_i, with rho V = B / g.
+    The pressure gradient that accelerates the air at a = dW/dt (averaged over the hull's
+    length along the wind) pushes the displaced volume with rho V a (Froude-Krylov); the air
+    the hull must accelerate with it adds k_i rho V a_i along body axis i (added mass; the
+    body's own acceleration is in the effective mass). In total
+    F_i = (rho V + m_a,i) a_i = (1 + k_i) rho V a_i, with rho V = B / g.
     """
-    ax, ay, az = air_acceleration(px, py, pz, t, wp, wf)
+    ax, ay, az = air_acceleration(px, py, pz, t, wp, wf, p[P_AILEN])
     # body components R^T a
     abx = R[0] * ax + R[3] * ay + R[6] * az
     aby = R[1] * ax + R[4] * ay + R[7] * az

@@ -282,48 +282,41 @@ def _air_velocity(x, y, z, t, wp, wf):
 
 
 @njit(**_JIT, inline="always")
-def _air_acceleration(x, y, z, t, wp, wf):
+def _air_acceleration(x, y, z, t, wp, wf, length):
     """Body of :func:`air_acceleration`."""
-    c, s = wp[W_DIRC], wp[W_DIRS]
-    xa = c * x + s * y
-    au = av = aw = 0.0
-    if wp[W_GUST_ON] != 0.0:
-        # d/dt of A (1 - cos(2 pi xi / L)) / 2 with xi = U_a t - (x_a - x_0)
-        xi = wp[W_TAYLOR_U] * t - (xa - wp[W_GUST_X0])
-        if 0.0 < xi < wp[W_GUST_LEN]:
-            k = 2.0 * math.pi / wp[W_GUST_LEN]
-            dg = 0.5 * k * wp[W_TAYLOR_U] * math.sin(k * xi)
-            au += wp[W_GUST_AU] * dg
-            av += wp[W_GUST_AV] * dg
-            aw += wp[W_GUST_AW] * dg
+    tau = length / wp[W_TAYLOR_U]
     if wp[W_TURB_ON] != 0.0 and wf.shape[1] > 1:
-        # central difference over one field step: exact for the piecewise-linear time
-        # interpolation averaged over that step, and continuous in t (the one-sided slope of
-        # the interpolant jumps at every sample)
-        h = 0.5 * wp[W_FIELD_DT]
-        u1, v1, w1 = _field_sample(xa, z, t + h, wp, wf)
-        u0, v0, w0 = _field_sample(xa, z, t - h, wp, wf)
-        idt = wp[W_FIELD_IDT]
-        au += (u1 - u0) * (idt * wp[W_FIELD_SU])
-        av += (v1 - v0) * (idt * wp[W_FIELD_SV])
-        aw += (w1 - w0) * (idt * wp[W_FIELD_SW])
-    return c * au - s * av, s * au + c * av, aw
+        tau = max(tau, wp[W_FIELD_DT])
+    if tau <= 0.0:
+        return 0.0, 0.0, 0.0
+    h = 0.5 * tau
+    u1, v1, w1 = _air_velocity(x, y, z, t + h, wp, wf)
+    u0, v0, w0 = _air_velocity(x, y, z, t - h, wp, wf)
+    it = 1.0 / tau
+    return (u1 - u0) * it, (v1 - v0) * it, (w1 - w0) * it
 
 
 @njit(**_JIT)
-def air_acceleration(x, y, z, t, wp, wf):
-    """Local time derivative dW/dt of the air velocity (inertial, m/s^2) at the fixed point
-    (x, y, z) [m] and time t [s]: the gust's analytically, the turbulence field's by a central
-    difference over one field time step. The steady mean wind contributes nothing.
+def air_acceleration(x, y, z, t, wp, wf, length):
+    """Local time derivative dW/dt (inertial, m/s^2) of the air velocity at the fixed point
+    (x, y, z) [m] and time t [s], averaged along the wind over ``length`` [m] (a hull's).
 
     Notes
     -----
+    The difference [W(t + tau/2) - W(t - tau/2)] / tau with tau = length / U_a (at least one
+    field time step) is exactly the time derivative of W averaged over the window tau, i.e. (by
+    Taylor's frozen flow) of W averaged over ``length`` along the wind. A body feels the
+    pressure gradient averaged over its volume, so eddies shorter than the hull add nothing;
+    without the average the acceleration of a von Karman field grows without bound with the
+    grid resolution (its spectrum f^2 S(f) ~ f^(1/3)). The steady mean wind cancels exactly; a
+    field linear in time gives its slope exactly.
+
     This is the acceleration of the air past a point held in place (what a moored body sees).
-    The frozen (Taylor) field advected at U_a has, by construction, no material acceleration
-    DW/Dt = dW/dt + U_a dW/dx_a = 0; the local derivative is the one the air-inertia force uses,
-    as in Morison's equation for a body held in a wave field.
+    The frozen field advected at U_a has, by construction, no material acceleration
+    DW/Dt = dW/dt + U_a dW/dx_a = 0; the local derivative is the one the air-inertia force
+    uses, as in Morison's equation for a body held in a wave field.
     """
-    return _air_acceleration(x, y, z, t, wp, wf)
+    return _air_acceleration(x, y, z, t, wp, wf, length)
 
 
 def air_is_unsteady(wp: np.ndarray, wf: np.ndarray) -> bool:
