@@ -1,13 +1,13 @@
 """Measure the yaw departures at large sideslip (README, issue 13).
 
-Usage: python scripts/sideslip_departures.py [--episodes 20]
+Usage: python scripts/sideslip_departures.py [--episodes 20] [--no-air-inertia]
 
 Prints (1) the static yaw acceleration against a yaw offset from the trim at 5, 10 and 15 m/s
 (negative: restoring) for the baseline fins (Viterna-Corrigan post-stall, 45 deg stall) and for
 [LN02]'s flat post-stall lift at the 2-D stall angle (16 deg), and (2) for the wind-scaled
 intensity classes light, moderate and severe at 3, 5, 10 and 15 m/s, the number of
 passive-winch episodes (120 s, seeds 100 ...) in which the sideslip at the aerostat CM
-exceeds 30 degrees.
+exceeds 30 degrees (with ``--no-air-inertia``: also with ``aerostat.air_inertia = false``).
 """
 
 from __future__ import annotations
@@ -23,6 +23,8 @@ FINS = {"viterna, 45 deg": None,
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--episodes", type=int, default=20)
+    ap.add_argument("--no-air-inertia", action="store_true",
+                    help="repeat the episode counts with the air-inertia force off")
     args = ap.parse_args(argv)
     print("static yaw acceleration [rad/s^2] against the yaw offset [deg]:")
     print("  fins             U m/s" + "".join(f"{d:>8d}" for d in OFFSETS_DEG))
@@ -30,11 +32,17 @@ def main(argv=None) -> int:
         for u in (5.0, 10.0, 15.0):
             curve = yaw_curve(u, over)
             print(f"  {name:16s} {u:5.0f} " + "".join(f"{v:+8.3f}" for v in curve))
-    print(f"passive episodes with sideslip > 30 deg at the CM (of {args.episodes}, 120 s):")
-    for turb in ("light", "moderate", "severe"):
-        counts = "".join(f"  {u:g} m/s: {int((max_sideslip(turb, u, args.episodes) > 30.0).sum()):2d}"
-                         for u in (3.0, 5.0, 10.0, 15.0))
-        print(f"  {turb:9s}{counts}")
+    runs = [("", None)]
+    if args.no_air_inertia:
+        runs.append((", air inertia off", {"aerostat.air_inertia": False}))
+    for label, over in runs:
+        print(f"passive episodes with sideslip > 30 deg at the CM (of {args.episodes}, 120 s"
+              f"{label}):")
+        for turb in ("light", "moderate", "severe"):
+            counts = "".join(
+                f"  {u:g} m/s: {int((max_sideslip(turb, u, args.episodes, over) > 30.0).sum()):2d}"
+                for u in (3.0, 5.0, 10.0, 15.0))
+            print(f"  {turb:9s}{counts}")
     return 0
 
 

@@ -49,10 +49,24 @@ def sideslip(euler: np.ndarray, v_rel: np.ndarray) -> np.ndarray:
     return np.degrees(np.arctan2(np.abs(body[:, 1]), body[:, 0]))
 
 
-def max_sideslip(turbulence: str, wind_speed: float, episodes: int) -> np.ndarray:
-    """Largest sideslip [deg] of each passive-winch episode (120 s, seeds 100, 101, ...)."""
+def max_sideslip(turbulence: str, wind_speed: float, episodes: int,
+                 overrides: dict | None = None) -> np.ndarray:
+    """Largest sideslip [deg] of each passive-winch episode (120 s, seeds 100, 101, ...).
+
+    Parameters
+    ----------
+    turbulence : str
+        The environment's turbulence (an intensity class or a config).
+    wind_speed : float
+        Episode wind speed [m/s].
+    episodes : int
+        Number of episodes.
+    overrides : dict, optional
+        Parameter overrides (dotted keys, e.g. ``{"aerostat.air_inertia": False}``).
+    """
     env = TetheredAerostatVectorEnv(num_envs=episodes, max_episode_steps=600, observation="full",
-                                    turbulence=turbulence, perturbation="none")
+                                    turbulence=turbulence, perturbation="none",
+                                    overrides=overrides)
     obs, _ = env.reset(seed=list(range(100, 100 + episodes)),
                        options={"wind_speed": [wind_speed] * episodes})
     b, lay = env.batch, env.batch.layout
