@@ -73,9 +73,10 @@ class AerostatParams:
     trim_pitch_deg: float = _f("deg", "SOURCED", ANY, "zero-wind trim pitch (negative = nose up)")
     k1: float = _f("-", "ESTIMATE", NONNEG, "axial added-mass coefficient")
     k3: float = _f("-", "ESTIMATE", NONNEG, "lateral added-mass coefficient (y and z)")
-    air_inertia: bool = _f("-", "SOURCED", BOOL, "Froude-Krylov plus added-mass force "
+    air_inertia: bool = _f("-", "ESTIMATE", BOOL, "Froude-Krylov plus added-mass force "
                            "(1 + k_i) rho V dW_i/dt of accelerating air on the hull (Morison's "
-                           "inertia term); zero in steady wind, so [LN02]'s results are unchanged")
+                           "inertia term, local dW/dt averaged over the hull length; an upper "
+                           "bound in convected frozen turbulence); zero in steady wind")
 
     @property
     def inertia_tensor(self) -> np.ndarray:
@@ -108,8 +109,9 @@ class FinParams:
     planform_area: float = _f("m^2", "ESTIMATE", NONNEG, "planform area per fin")
     aspect_ratio: float = _f("-", "ESTIMATE", POSITIVE, "aspect ratio used for induced drag")
     CL_alpha: float = _f("1/rad", "CALIB", NONNEG, "3-D lift slope incl. hull interference loss; calibrated (0.68 x McCormick) to the 67.4 s lateral pendulum")
-    alpha_stall_deg: float = _f("deg", "ESTIMATE", STALL, "3-D stall angle of the low-aspect-ratio "
-                                "fin (linear C_L below it)")
+    alpha_stall_deg: float = _f("deg", "CALIB", STALL, "3-D stall angle of the low-aspect-ratio "
+                                "fin (linear C_L below it); calibrated to a restoring static yaw "
+                                "moment at every yaw offset to 90 deg")
     post_stall: str = _f("-", "SOURCED", ANY, "beyond stall: 'viterna' (Viterna-Corrigan normal "
                          "force to C_D,max at 90 deg) or 'flat' ([LN02]'s C_L held flat)")
     CD0: float = _f("-", "ESTIMATE", NONNEG, "parasite drag coefficient")
