@@ -1,5 +1,5 @@
-"""The yaw-departure figures of the README ("Known limitation: yaw departures at large
-sideslip"), measured by aerostat_gym.analysis.sideslip (scripts/sideslip_departures.py)."""
+"""The sideslip figures of the README ("Large-angle fins, sideslip and the air-inertia force"),
+measured by aerostat_gym.analysis.sideslip (scripts/sideslip_departures.py)."""
 
 import numpy as np
 import pytest
