@@ -22,9 +22,8 @@ from .episodes import (
     DEFAULT_HORIZON,
     TrimTable,
     field_length_needed,
-    normalise_bank,
     sample_episode,
-    turbulence_bank,
+    unit_bank,
 )
 
 NO_BANK = np.zeros((1, 1, 0, 3))
@@ -87,8 +86,7 @@ class EnvBatch:
         u_max = self.trims.speeds[-1] * _advection_factor(self.params, turb)
         need = field_length_needed(turb, u_max, self.horizon)
         # unit-variance fields, scaled per episode to its mean wind (episodes._intensity)
-        return normalise_bank(turbulence_bank(turb.unit(), self.task.wind_bank_size,
-                                              self.task.wind_bank_seed, need))
+        return unit_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
 
     def __getstate__(self):  # the trims and the bank are rebuilt (or found in the cache)
         d = dict(self.__dict__)

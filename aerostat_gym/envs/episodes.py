@@ -181,19 +181,35 @@ def _field(cfg, bank_shape, ua, horizon, wp, rng) -> tuple[int, float]:
 # --- per-episode turbulence intensity (issue 13) -------------------------------------------------
 
 
+_UNIT_BANKS: dict = {}  # id -> bank already normalised (holding it keeps the id unique)
+
+
+def unit_bank(cfg: TurbulenceConfig, size: int, seed: int, length: float) -> np.ndarray:
+    """The turbulence bank of ``cfg``'s class with unit-variance fields: :func:`turbulence_bank`
+    of :meth:`TurbulenceConfig.unit`, normalised once by :func:`normalise_bank` (a bank shared
+    through the cache is never rescaled again, so every environment reads the same bits)."""
+    bank = turbulence_bank(cfg.unit(), size, seed, length)
+    if _UNIT_BANKS.get(id(bank)) is not bank:
+        normalise_bank(bank)
+        _UNIT_BANKS[id(bank)] = bank
+    return bank
+
+
 def normalise_bank(bank: np.ndarray) -> np.ndarray:
     """Scale every field of a bank, per height row and component, to unit mean square, in
-    place (idempotent); returns the bank.
+    place; returns the bank.
 
     A Veers field's variance is itself random (Gaussian Fourier coefficients: the eight fields
     of the default bank range 0.46-1.40 in variance). Scaling a row by a constant leaves its
     spectral shape and its coherence with every other row unchanged, so the fields stay valid
     samples of the spectrum, and each episode's sigma is then the one its class asks for.
     """
-    if bank.shape[2] == 0:
+    n = bank.shape[2]
+    if n == 0:
         return bank
-    rms = np.sqrt(np.mean(bank * bank, axis=2, keepdims=True))
-    np.divide(bank, np.where(rms > 0.0, rms, 1.0), out=bank)
+    for field in bank:  # one field at a time: no temporary the size of the bank
+        rms = np.sqrt(np.einsum("kjc,kjc->kc", field, field) / n)
+        field /= np.where(rms > 0.0, rms, 1.0)[:, None, :]
     return bank
 
 
