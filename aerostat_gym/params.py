@@ -34,8 +34,8 @@ class ParameterError(ValueError):
 
 # --- field helpers -----------------------------------------------------------------------------
 
-POSITIVE, NONNEG, ANY, INT_GE1, STALL, VEC3, COEFFS = (
-    "positive", "nonneg", "any", "int>=1", "stall", "vec3", "coeffs",
+POSITIVE, NONNEG, ANY, INT_GE1, STALL, VEC3, COEFFS, BOOL = (
+    "positive", "nonneg", "any", "int>=1", "stall", "vec3", "coeffs", "bool",
 )
 
 
@@ -73,6 +73,11 @@ class AerostatParams:
     trim_pitch_deg: float = _f("deg", "SOURCED", ANY, "zero-wind trim pitch (negative = nose up)")
     k1: float = _f("-", "ESTIMATE", NONNEG, "axial added-mass coefficient")
     k3: float = _f("-", "ESTIMATE", NONNEG, "lateral added-mass coefficient (y and z)")
+    air_inertia: bool = _f("-", "ESTIMATE", BOOL, "Froude-Krylov plus added-mass force "
+                           "(1 + k_i) rho V dW_i/dt of accelerating air on the hull (Morison's "
+                           "inertia term, local dW/dt averaged over the hull length; an upper "
+                           "bound in convected frozen turbulence, hence off in the shipped "
+                           "files); zero in steady wind")
 
     @property
     def inertia_tensor(self) -> np.ndarray:
@@ -105,7 +110,11 @@ class FinParams:
     planform_area: float = _f("m^2", "ESTIMATE", NONNEG, "planform area per fin")
     aspect_ratio: float = _f("-", "ESTIMATE", POSITIVE, "aspect ratio used for induced drag")
     CL_alpha: float = _f("1/rad", "CALIB", NONNEG, "3-D lift slope incl. hull interference loss; calibrated (0.68 x McCormick) to the 67.4 s lateral pendulum")
-    alpha_stall_deg: float = _f("deg", "ESTIMATE", STALL, "stall angle; C_L flat beyond it")
+    alpha_stall_deg: float = _f("deg", "CALIB", STALL, "3-D stall angle of the low-aspect-ratio "
+                                "fin (linear C_L below it); calibrated to a restoring static yaw "
+                                "moment at every yaw offset to 90 deg")
+    post_stall: str = _f("-", "SOURCED", ANY, "beyond stall: 'viterna' (Viterna-Corrigan normal "
+                         "force to C_D,max at 90 deg) or 'flat' ([LN02]'s C_L held flat)")
     CD0: float = _f("-", "ESTIMATE", NONNEG, "parasite drag coefficient")
     oswald_e: float = _f("-", "ESTIMATE", POSITIVE, "Oswald efficiency")
     panels: tuple = _f("-", "SOURCED", ANY, "fin panels (inverted Y: upper, port, starboard)")
@@ -205,6 +214,7 @@ SECTIONS = {
 WIND_PROFILES = ("uniform", "power", "log")
 TURBULENCE_PRESETS = ("none", "light", "moderate", "severe")
 TURBULENCE_MODELS = ("von_karman", "dryden")
+POST_STALL_MODELS = ("viterna", "flat")
 
 # --- validation ----------------------------------------------------------------------------------
 
@@ -230,6 +240,10 @@ def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
     if f.type in ("str", str):
         if not isinstance(value, str):
             raise ParameterError(f"{name} must be a string, got {value!r}")
+        return value
+    if check == BOOL:
+        if not isinstance(value, bool):
+            raise ParameterError(f"{name} must be true or false, got {value!r}")
         return value
     if check == INT_GE1:
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
@@ -281,6 +295,8 @@ def _cross_checks(p: Params) -> None:
     if p.wind.turbulence_model not in TURBULENCE_MODELS:
         raise ParameterError(
             f"wind.turbulence_model must be one of {TURBULENCE_MODELS}, got {p.wind.turbulence_model!r}")
+    if p.fins.post_stall not in POST_STALL_MODELS:
+        raise ParameterError(f"fins.post_stall must be one of {POST_STALL_MODELS}, got {p.fins.post_stall!r}")
     if p.wind.profile not in WIND_PROFILES:
         raise ParameterError(f"wind.profile must be one of {WIND_PROFILES}, got {p.wind.profile!r}")
     if p.winch.min_length >= p.winch.max_length:
@@ -520,6 +536,9 @@ class Derived:
       to l_u, the element dashpot c* = b / l_u (force per unit of relative axial speed) does not
       depend on the element length; it is what the compiled core uses.
     - added masses m_a = k rho V per axis; effective masses m_e = m + m_a.
+    - fin C_D,max = 1.11 + 0.018 A, the deep-stall drag (normal force at 90 deg) of a plate of
+      aspect ratio A (Viterna & Corrigan 1982, "Fixed pitch rotor performance of large
+      horizontal axis wind turbines", NASA CP-2230; the AirfoilPrep / WISDEM extrapolation).
     """
 
     buoyancy: float
@@ -537,6 +556,7 @@ class Derived:
     effective_mass: tuple
     tether_weight: float
     reference_area: float
+    fin_cd_max: float
 
     @classmethod
     def from_params(cls, p: Params) -> Derived:
@@ -570,4 +590,5 @@ class Derived:
             effective_mass=tuple(a.mass + m for m in ma),
             tether_weight=mu * t.length * env.g,
             reference_area=a.volume ** (2.0 / 3.0),
+            fin_cd_max=1.11 + 0.018 * p.fins.aspect_ratio,
         )

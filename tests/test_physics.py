@@ -15,7 +15,8 @@ from aerostat_gym.params import load_params
 from aerostat_gym.sim import Model, SimulationError, simulate
 
 AERO_OFF = {"hull.CD0": 0.0, "hull.Cdc": 0.0, "hull.eta_k": 0.0, "fins.CL_alpha": 0.0,
-            "fins.CD0": 0.0, "tether.Cd_normal": 0.0, "tether.damping_ratio": 0.0}
+            "fins.CD0": 0.0, "tether.Cd_normal": 0.0, "tether.damping_ratio": 0.0,
+            "fins.post_stall": "flat"}  # the Viterna normal force does not scale with CL_alpha
 
 
 @pytest.fixture(scope="module")

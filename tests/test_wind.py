@@ -242,12 +242,15 @@ def test_mil_low_altitude_table():
 
 
 def test_presets_documented_values():
+    """The classes are wind-scaled (issue 13): at 8 m/s uniform wind the MIL model gives
+    sigma_u = 0.5 / 1 / 1.5 x 0.804 m/s (W20 = U), sigma_v = sigma_u, sigma_w = 0.1 W20 f."""
     assert set(PRESETS) == {"none", "light", "moderate", "severe"}
     assert PRESETS["none"].is_off
-    for name, su in (("light", 0.8), ("moderate", 1.6), ("severe", 2.4)):
-        c = PRESETS[name]
-        assert c.sigmas == pytest.approx((su, 0.8 * su, 0.6 * su))
-        assert c.integral_scales() == pytest.approx((300.0, 120.0, 60.0))
+    wp = pack_wind("uniform", 8.0)
+    for name, f in (("light", 0.5), ("moderate", 1.0), ("severe", 1.5)):
+        c = PRESETS[name].for_wind(wp)
+        assert c.sigmas == pytest.approx((0.804 * f, 0.804 * f, 0.8 * f), abs=5e-4)
+        assert c.integral_scales() == pytest.approx((304.7, 152.4, 150.0), abs=0.05)
     cfg = TurbulenceConfig.from_mil("light", 280.0)
     assert cfg.sigma_u == pytest.approx(0.79, abs=0.01)
 

@@ -12,9 +12,11 @@ import time
 
 import numpy as np
 
+from ..analysis.intensity import air_inertia_force
+from ..params import load_params
 from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
-from ..wind.field import build_wind, field_heights, field_times
-from ..wind.presets import METHODS, PRESETS
+from ..wind.field import build_wind, field_heights, field_times, mean_vector
+from ..wind.presets import INTENSITY_MODELS, METHODS, PRESETS
 from ..wind.sizing import FROM_CONFIG, sized_turbulence
 from ..wind.spectra import MODELS
 from ..wind.stats import (
@@ -47,6 +49,8 @@ def add_wind_parser(subparsers) -> argparse.ArgumentParser:
                    help="mean profile (default: the configuration's wind.profile)")
     p.add_argument("--reference-height", type=float, default=None,
                    help="reference height of the power/log profile [m] (default: the configuration's)")
+    p.add_argument("--intensity-model", choices=INTENSITY_MODELS,
+                   help="how sigma follows the mean wind (default: the preset's, 'mil')")
     p.add_argument("--model", choices=MODELS, help="override the preset's spectrum")
     p.add_argument("--method", choices=METHODS, help="override the generation method")
     p.add_argument("--height", type=float, help="aerostat nominal height (field advection) [m] "
@@ -64,7 +68,8 @@ def _config(args, params):
     preset = args.preset or (FROM_CONFIG if args.config else "moderate")
     cfg = sized_turbulence(params, preset)
     changes = {k: v for k, v in (("model", args.model), ("method", args.method),
-                                 ("reference_height", args.height)) if v is not None}
+                                 ("reference_height", args.height),
+                                 ("intensity_model", args.intensity_model)) if v is not None}
     if changes.get("method") == "filter" and "model" not in changes:
         changes["model"] = "dryden"
     return cfg.replace(**changes) if changes else cfg
@@ -90,15 +95,26 @@ def wind_command(args) -> int:
     except (ValueError, TypeError) as e:
         print(f"aerostat-gym wind: error: {e}")
         return 2
-    out = {"preset": args.preset or (FROM_CONFIG if args.config else "moderate"), "model": cfg.model, "method": cfg.method, "seed": args.seed,
-           "duration_s": args.duration, "mean_speed": args.speed,
+    out = {"preset": args.preset or (FROM_CONFIG if args.config else "moderate"),
+           "intensity_model": cfg.intensity_model, "model": cfg.model, "method": cfg.method,
+           "seed": args.seed, "duration_s": args.duration, "mean_speed": args.speed,
            "field_shape": list(wf.shape), "generation_s": gen_s}
+    cfg = cfg.for_wind(mean_vector(mean))  # the class's sigmas in this mean wind
     if not cfg.is_off:
         out.update(realised_statistics(cfg, wp, fields))
+        out["air_inertia"] = _air_inertia(cfg, wp, wf, args.duration)
     print(json.dumps(out, indent=2) if args.json else _table(out))
     if args.plot and not cfg.is_off:
         _plot(args.plot, cfg, wp, fields)
     return 0
+
+
+def _air_inertia(cfg, wp, wf, duration: float) -> dict:
+    """Air-inertia force on the baseline hull held at the field's reference height."""
+    p = load_params()
+    a = p.aerostat
+    return air_inertia_force(wp, wf, (0.0, 0.0, cfg.reference_height),
+                             p.environment.rho_air * a.volume, a.k1, a.k3, a.length, duration)
 
 
 def _table(out: dict) -> str:
@@ -115,6 +131,11 @@ def _table(out: dict) -> str:
         lines.append(f"{name:4}{c['sigma']:10.3f}{c['sigma_target']:10.3f}"
                      f"{c['integral_length']:12.1f}{c['integral_length_target']:10.1f}"
                      f"{c['integral_length_acf']:16.1f}")
+    ai = out["air_inertia"]
+    lines.append(f"air inertia on the baseline hull held at {out['height']:.0f} m ((1 + k_i) rho V "
+                 f"dW_i/dt): RMS axial {ai['rms_axial_n']:.0f} N, lateral {ai['rms_lateral_n']:.0f} N, "
+                 f"vertical {ai['rms_vertical_n']:.0f} N, peak |F| {ai['peak_n']:.0f} N "
+                 f"(RMS |dW/dt| {ai['rms_air_acceleration_m_s2']:.3f} m/s^2)")
     lines.append("coherence realised/target (IEC), band-averaged around f:")
     for name, c in out["components"].items():
         for r, d in c["coherence"].items():

@@ -24,7 +24,7 @@ from .episodes import (
     TrimTable,
     field_length_needed,
     sample_episode,
-    turbulence_bank,
+    unit_bank,
 )
 
 NO_BANK = np.zeros((1, 1, 0, 3))
@@ -101,7 +101,8 @@ class EnvBatch:
             return NO_BANK
         u_max = self.trims.speeds[-1] * _advection_factor(self.params, turb)
         need = field_length_needed(turb, u_max, self.horizon)
-        return turbulence_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
+        # unit-variance fields, scaled per episode to its mean wind (episodes._intensity)
+        return unit_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
 
     def __getstate__(self):  # the trims and the bank are rebuilt (or found in the cache)
         d = dict(self.__dict__)
