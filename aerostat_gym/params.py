@@ -34,8 +34,8 @@ class ParameterError(ValueError):
 
 # --- field helpers -----------------------------------------------------------------------------
 
-POSITIVE, NONNEG, ANY, INT_GE1, STALL, VEC3, COEFFS = (
-    "positive", "nonneg", "any", "int>=1", "stall", "vec3", "coeffs",
+POSITIVE, NONNEG, ANY, INT_GE1, STALL, VEC3, COEFFS, BOOL = (
+    "positive", "nonneg", "any", "int>=1", "stall", "vec3", "coeffs", "bool",
 )
 
 
@@ -80,6 +80,11 @@ class AerostatParams:
     trim_pitch_deg: float = _f("deg", "SOURCED", ANY, "zero-wind trim pitch (negative = nose up)")
     k1: float = _f("-", "ESTIMATE", NONNEG, "axial added-mass coefficient")
     k3: float = _f("-", "ESTIMATE", NONNEG, "lateral added-mass coefficient (y and z)")
+    air_inertia: bool = _f("-", "ESTIMATE", BOOL, "Froude-Krylov plus added-mass force "
+                           "(1 + k_i) rho V dW_i/dt of accelerating air on the hull (Morison's "
+                           "inertia term, local dW/dt averaged over the hull length; an upper "
+                           "bound in convected frozen turbulence, hence off in the shipped "
+                           "files); zero in steady wind")
 
     @property
     def inertia_tensor(self) -> np.ndarray:
@@ -112,7 +117,11 @@ class FinParams:
     planform_area: float = _f("m^2", "ESTIMATE", NONNEG, "planform area per fin")
     aspect_ratio: float = _f("-", "ESTIMATE", POSITIVE, "aspect ratio used for induced drag")
     CL_alpha: float = _f("1/rad", "CALIB", NONNEG, "3-D lift slope incl. hull interference loss; calibrated (0.68 x McCormick) to the 67.4 s lateral pendulum")
-    alpha_stall_deg: float = _f("deg", "ESTIMATE", STALL, "stall angle; C_L flat beyond it")
+    alpha_stall_deg: float = _f("deg", "CALIB", STALL, "3-D stall angle of the low-aspect-ratio "
+                                "fin (linear C_L below it); calibrated to a restoring static yaw "
+                                "moment at every yaw offset to 90 deg")
+    post_stall: str = _f("-", "SOURCED", ANY, "beyond stall: 'viterna' (Viterna-Corrigan normal "
+                         "force to C_D,max at 90 deg) or 'flat' ([LN02]'s C_L held flat)")
     CD0: float = _f("-", "ESTIMATE", NONNEG, "parasite drag coefficient")
     oswald_e: float = _f("-", "ESTIMATE", POSITIVE, "Oswald efficiency")
     panels: tuple = _f("-", "SOURCED", ANY, "fin panels (inverted Y: upper, port, starboard)")
@@ -187,6 +196,9 @@ class Params:
     winch: WinchParams
     wind: WindParams
     simulation: SimulationParams
+    #: Status of each value as the user's file states it ("section.key" -> SOURCED, ..., USER),
+    #: read from the status comments of the TOML and set to USER by overrides; not compared.
+    provenance: tuple = field(default=(), compare=False, repr=False)
 
     def replace(self, **dotted: Any) -> Params:
         """Return a copy with single values replaced, e.g. ``replace(**{"tether.length": 150})``."""
@@ -211,6 +223,7 @@ SECTIONS = {
 WIND_PROFILES = ("uniform", "power", "log")
 TURBULENCE_PRESETS = ("none", "light", "moderate", "severe")
 TURBULENCE_MODELS = ("von_karman", "dryden")
+POST_STALL_MODELS = ("viterna", "flat")
 
 # --- validation ----------------------------------------------------------------------------------
 
@@ -243,6 +256,10 @@ def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
     if f.type in ("str", str):
         if not isinstance(value, str):
             raise ParameterError(f"{name} must be a string, got {value!r}")
+        return value
+    if check == BOOL:
+        if not isinstance(value, bool):
+            raise ParameterError(f"{name} must be true or false, got {value!r}")
         return value
     if check == INT_GE1:
         if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_ELEMENTS:
@@ -295,12 +312,15 @@ def _cross_checks(p: Params) -> None:
     if p.wind.turbulence_model not in TURBULENCE_MODELS:
         raise ParameterError(
             f"wind.turbulence_model must be one of {TURBULENCE_MODELS}, got {p.wind.turbulence_model!r}")
+    if p.fins.post_stall not in POST_STALL_MODELS:
+        raise ParameterError(f"fins.post_stall must be one of {POST_STALL_MODELS}, got {p.fins.post_stall!r}")
     if p.wind.profile not in WIND_PROFILES:
         raise ParameterError(f"wind.profile must be one of {WIND_PROFILES}, got {p.wind.profile!r}")
     if p.winch.min_length >= p.winch.max_length:
         raise ParameterError(
             f"winch.min_length ({p.winch.min_length}) must be < winch.max_length ({p.winch.max_length})"
         )
+    check_length_within_winch(p)
     if not -89.0 < p.aerostat.trim_pitch_deg < 89.0:
         raise ParameterError(f"aerostat.trim_pitch_deg must lie in (-89, 89), got {p.aerostat.trim_pitch_deg}")
     d = Derived.from_params(p)
@@ -344,6 +364,16 @@ def _feasibility(p: Params, d: Derived) -> None:
             f"({w.safe_working_load} N)")
 
 
+def check_length_within_winch(p: Params) -> None:
+    """The paid-out tether length must lie inside the winch's length limits: beyond
+    winch.max_length the drum would hold a negative length of line (and negative mass)."""
+    L, w = p.tether.length, p.winch
+    if not w.min_length <= L <= w.max_length:
+        raise ParameterError(
+            f"tether.length = {L} m lies outside the winch's limits winch.min_length = "
+            f"{w.min_length} m .. winch.max_length = {w.max_length} m")
+
+
 def params_from_dict(data: dict) -> Params:
     """Build :class:`Params` from a nested dict (the parsed TOML), strictly."""
     if not isinstance(data, dict):
@@ -382,26 +412,72 @@ def apply_overrides(p: Params, overrides: dict[str, Any]) -> Params:
         if name not in data[sec]:
             raise ParameterError(f"unknown parameter {key!r}")
         data[sec][name] = list(value) if isinstance(value, tuple) else value
-    return params_from_dict(data)
+    new = params_from_dict(data)
+    prov = dict(p.provenance)
+    prov.update({key: USER for key in overrides})
+    return dataclasses.replace(new, provenance=tuple(sorted(prov.items())))
+
+
+BASELINE_NAME = "aeros_flightcam"
+
+
+def shipped_configs() -> tuple[str, ...]:
+    """Names of the parameter files shipped in aerostat_gym/data (loadable by name)."""
+    data = resources.files("aerostat_gym").joinpath("data")
+    return tuple(sorted(f.name[:-5] for f in data.iterdir() if f.name.endswith(".toml")))
+
+
+def _config_text(path: str | Path | None) -> tuple[str, str]:
+    """(TOML text, source name) of a path, a shipped configuration's name, or the baseline."""
+    if path is None:
+        path = BASELINE_NAME
+    if not Path(path).is_file() and str(path) in shipped_configs():
+        return resources.files("aerostat_gym").joinpath(f"data/{path}.toml").read_text(), str(path)
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(f"parameter file not found: {path} (shipped configurations: "
+                             f"{', '.join(shipped_configs())})")
+    return path.read_text(), str(path)
 
 
 def load_params(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Params:
-    """Load parameters from a TOML file (default: the shipped baseline) and apply overrides."""
-    if path is None:
-        text = resources.files("aerostat_gym").joinpath("data/aeros_flightcam.toml").read_text()
-        source = "baseline"
-    else:
-        path = Path(path)
-        if not path.is_file():
-            raise ParameterError(f"parameter file not found: {path}")
-        text = path.read_text()
-        source = str(path)
+    """Load parameters from a TOML file, or a shipped configuration by name (``"tcom_32m"``;
+    default: the baseline), and apply overrides."""
+    text, source = _config_text(path)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{source}: invalid TOML: {exc}") from exc
     p = params_from_dict(data)
+    p = dataclasses.replace(p, provenance=tuple(sorted(status_comments(text).items())))
     return apply_overrides(p, overrides) if overrides else p
+
+
+STATUSES = ("SOURCED", "DERIVED", "ESTIMATE", "CALIB", "USER")
+USER = "USER"
+
+
+def status_comments(text: str) -> dict[str, str]:
+    """The status word (SOURCED, DERIVED, ESTIMATE, CALIB or USER) of every ``key = value  #
+    ... STATUS ...`` line of a parameter TOML, as {"section.key": status}; fin panels are named
+    ``fins.panels[i].key``."""
+    out, section, panel = {}, "", -1
+    for line in text.splitlines():
+        body = line.split("#", 1)[0].strip()
+        if body.startswith("[[fins.panels]]"):
+            panel += 1
+            section = f"fins.panels[{panel}]"
+            continue
+        if body.startswith("["):
+            section = body.strip("[]").strip()
+            continue
+        if "=" not in body or "#" not in line:
+            continue
+        comment = line.split("#", 1)[1]
+        found = [w.strip("(),:;") for w in comment.split() if w.strip("(),:;") in STATUSES]
+        if found:
+            out[f"{section}.{body.split('=', 1)[0].strip()}"] = found[0]
+    return out
 
 
 def default_params(**overrides: Any) -> Params:
@@ -438,16 +514,51 @@ def dumps_toml(p: Params) -> str:
 
 
 def parameter_table(p: Params | None = None) -> list[dict]:
-    """Rows (name, value, unit, status, description) of every input, for reports and the CLI."""
+    """Rows (name, value, unit, status, description) of every input, for reports and the CLI.
+
+    The status follows the value: the status comment of the user's own file where it has one
+    (:attr:`Params.provenance`), USER for a value set by an override or one that differs from
+    the shipped baseline without a comment, and the baseline's status (dataclass metadata)
+    for a value equal to the baseline's.
+    """
     p = p or load_params()
+    base = _baseline_values()
+    prov = dict(p.provenance)
+    rows = _raw_rows(p)
+    for r in rows:
+        r["status"] = _status(r, prov, base)
+    return rows
+
+
+def _status(row: dict, provenance: dict, baseline: dict) -> str:
+    name = row["name"]
+    stated = provenance.get(name) or provenance.get(name.split(".panels[")[0] + ".panels")
+    if stated is not None:
+        return stated
+    return row["status"] if baseline.get(name) == row["value"] else USER
+
+
+def _baseline_values() -> dict:
+    """{name: value} of the shipped baseline (parsed once)."""
+    if not _BASELINE_VALUES:
+        text, _ = _config_text(BASELINE_NAME)
+        base = params_from_dict(tomllib.loads(text))
+        _BASELINE_VALUES.update({r["name"]: r["value"] for r in _raw_rows(base)})
+    return _BASELINE_VALUES
+
+
+_BASELINE_VALUES: dict = {}
+
+
+def _raw_rows(p: Params) -> list[dict]:
     rows = []
     for sec in SECTIONS:
         obj = getattr(p, sec)
         for f in fields(obj):
             if f.name == "panels":
                 for i, pan in enumerate(obj.panels):
-                    for g in fields(pan):
-                        rows.append(_row(f"fins.panels[{i}].{g.name}", getattr(pan, g.name), g))
+                    rows.extend(_row(f"fins.panels[{i}].{g.name}", getattr(pan, g.name), g)
+                                for g in fields(pan))
             else:
                 rows.append(_row(f"{sec}.{f.name}", getattr(obj, f.name), f))
     return rows
@@ -475,6 +586,9 @@ class Derived:
       to l_u, the element dashpot c* = b / l_u (force per unit of relative axial speed) does not
       depend on the element length; it is what the compiled core uses.
     - added masses m_a = k rho V per axis; effective masses m_e = m + m_a.
+    - fin C_D,max = 1.11 + 0.018 A, the deep-stall drag (normal force at 90 deg) of a plate of
+      aspect ratio A (Viterna & Corrigan 1982, "Fixed pitch rotor performance of large
+      horizontal axis wind turbines", NASA CP-2230; the AirfoilPrep / WISDEM extrapolation).
     """
 
     buoyancy: float
@@ -492,6 +606,7 @@ class Derived:
     effective_mass: tuple
     tether_weight: float
     reference_area: float
+    fin_cd_max: float
 
     @classmethod
     def from_params(cls, p: Params) -> Derived:
@@ -525,4 +640,5 @@ class Derived:
             effective_mass=tuple(a.mass + m for m in ma),
             tether_weight=mu * t.length * env.g,
             reference_area=a.volume ** (2.0 / 3.0),
+            fin_cd_max=1.11 + 0.018 * p.fins.aspect_ratio,
         )

@@ -1,18 +1,34 @@
-"""Registration of ``TetheredAerostat-v0`` (runs on ``import aerostat_gym``; imports only
-Gymnasium: the environment's modules load when an environment is made)."""
+"""Registration of the environment's task variants (runs on ``import aerostat_gym``; imports only
+Gymnasium: the environment's modules load when an environment is made).
+
+Each task is an id, versioned in Gymnasium's style, whose registered keyword arguments fix the
+conditions; ``gym.make(ID)`` reproduces them with no further arguments, and keyword arguments
+passed to ``gym.make`` override them.
+"""
 
 from __future__ import annotations
 
 ENV_ID = "TetheredAerostat-v0"
 MAX_EPISODE_STEPS = 600  # 120 s at the default 0.2 s control step
 
+#: Task id -> (registered keyword arguments, one-line description).
+TASKS: dict[str, tuple[dict, str]] = {
+    ENV_ID: ({}, "the default task: 3-15 m/s, moderate turbulence, mixed perturbation (swing, "
+                 "pitch kick and, half the time, a 1 - cos gust)"),
+    "TetheredAerostatDamping-v0": (
+        {"turbulence": "none", "perturbation": "displacement"},
+        "calm-air damping: 3-15 m/s steady wind, an initial swing of up to 10 m along and 5 m "
+        "across the wind and a pitch kick of up to 0.05 rad (the shipped PPO policy's task)"),
+}
+
 
 def register() -> None:
-    """Register the environment with Gymnasium (idempotent)."""
+    """Register every task with Gymnasium (idempotent)."""
     import gymnasium as gym
 
-    if ENV_ID in gym.registry:
-        return
-    gym.register(id=ENV_ID, entry_point="aerostat_gym.envs.env:TetheredAerostatEnv",
-                 vector_entry_point="aerostat_gym.envs.vector:make_vec",
-                 max_episode_steps=MAX_EPISODE_STEPS)
+    for task_id, (kwargs, _) in TASKS.items():
+        if task_id in gym.registry:
+            continue
+        gym.register(id=task_id, entry_point="aerostat_gym.envs.env:TetheredAerostatEnv",
+                     vector_entry_point="aerostat_gym.envs.vector:make_vec",
+                     max_episode_steps=MAX_EPISODE_STEPS, kwargs=dict(kwargs))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +14,8 @@ from aerostat_gym.agents.sb3io import PolicyError
 from aerostat_gym.agents.train import train
 from aerostat_gym.cli import main
 from aerostat_gym.envs.spaces import N_OBS
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_baselines_have_sb3_predict_signature():
@@ -86,9 +89,15 @@ def test_policy_for_another_observation_layout_is_rejected(tmp_path):
     model = PPO("MlpPolicy", Other(), n_steps=8, batch_size=8)
     path = tmp_path / "other.zip"
     model.save(path)
-    with pytest.raises(PolicyError, match="observation"):
-        pol = load_policy(str(path))
-        policy_obs(pol if isinstance(pol, SB3Policy) else None, np.zeros((1, N_OBS + 69)))
+    with pytest.raises(PolicyError, match=r"trained on observations of shape \(7,\)"):
+        load_policy(str(path))
+
+    class Wide:  # a policy for a layout that is neither the standard nor the full one
+        obs_dim = N_OBS + 5
+
+    with pytest.raises(PolicyError, match="another observation layout"):
+        policy_obs(Wide(), np.zeros((1, N_OBS + 69), np.float32))
+    assert policy_obs(SB3Policy.__new__(SB3Policy), np.zeros((2, N_OBS))).shape == (2, N_OBS)
 
 
 @pytest.mark.slow
@@ -98,7 +107,7 @@ def test_full_training_reaches_shipped_score(tmp_path):
     from aerostat_gym.agents.evaluate import suite_score
 
     run = train("ppo", seed=0, run_dir=tmp_path / "full", progress_bar=False)
-    shipped = suite_score(load_policy("agents/ppo_tethered_aerostat.zip"), "damping")
+    shipped = suite_score(load_policy("shipped"), "damping")
     best = max(e["score"] for e in json.loads((run / "evaluations.json").read_text()))
     assert best >= shipped - 0.1 * abs(shipped)
 
@@ -117,7 +126,21 @@ def test_resume_from_checkpoint_continues(tmp_path):
 
 @pytest.mark.parametrize("algo", ["sac", "td3"])
 def test_off_policy_configs_train(tmp_path, algo):
-    """The shipped SAC and TD3 configurations build and run (a short smoke run)."""
-    run = train(algo, timesteps=1200, n_envs=4, seed=0, run_dir=tmp_path / algo,
+    """The shipped SAC and TD3 configurations build and learn: with learning_starts lowered to
+    256 (the rest as shipped), 1200 steps on 4 environments run in rollouts of train_freq 8
+    steps x 4 envs = 32 steps, so 38 rollouts (1216 steps); the 30 that end past 256 steps
+    each take gradient_steps = 4 updates: 120."""
+    import yaml
+    from stable_baselines3 import SAC, TD3
+
+    shipped = yaml.safe_load((ROOT / "agents" / "hyperparams" / f"{algo}.yml").read_text())
+    shipped["TetheredAerostat-v0"].update(learning_starts=256, batch_size=64)
+    config = tmp_path / f"{algo}.yml"
+    config.write_text(yaml.safe_dump(shipped))
+    run = train(algo, config, timesteps=1200, n_envs=4, seed=0, run_dir=tmp_path / algo,
                 progress_bar=False, threads=1, eval_freq=10**9)
-    assert (run / f"{algo}_final.zip").is_file()
+    model = {"sac": SAC, "td3": TD3}[algo].load(run / f"{algo}_final.zip")
+    assert model.num_timesteps == 1216
+    assert model._n_updates == 120
+    a, _ = model.predict(np.zeros(N_OBS, np.float32), deterministic=True)
+    assert a.shape == (1,) and abs(float(a[0])) <= 1.0

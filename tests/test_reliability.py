@@ -433,7 +433,7 @@ def test_12_banded_jacobian_equals_the_column_by_column_one():
     p = load_params(overrides={"tether.n_elements": 12})
     eq = find_equilibrium(p, 8.0)
     model = Model(p, 0.0)
-    trim_module._set_speed(model, p, 8.0)
+    model.set_wind(8.0)
     idx = trim_module._unknown_index(model)
     steps = np.full(idx.size, 1e-5)
     r = trim_module._residual(model, eq.x)

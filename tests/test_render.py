@@ -3,7 +3,6 @@ and mode validation. Frames come from the baseline trim at U = 10 m/s; no simula
 """
 
 import dataclasses
-import time
 import warnings
 
 import numpy as np
@@ -110,17 +109,13 @@ def test_figure_reused(params, frame):
     r.render(frame)
     fig = r.figure
     counts = (len(fig.axes), [len(ax.get_children()) for ax in fig.axes], len(fig.texts))
-    n, t0 = 20, time.perf_counter()
-    for k in range(n):
+    for k in range(20):
         f = dataclasses.replace(frame, time=0.1 * k, euler=frame.euler + 0.01 * k,
                                 reel_speed=0.05 * k, tension=frame.tension + 10.0 * k)
         img = r.render(f)
-    ms = (time.perf_counter() - t0) / n * 1e3
-    print(f"render: {ms:.1f} ms per frame (800 x 480, rgb_array)")
-    assert r.figure is fig
+    assert r.figure is fig  # one figure, updated in place: no artists pile up
     assert (len(fig.axes), [len(ax.get_children()) for ax in fig.axes], len(fig.texts)) == counts
     assert img.shape == (480, 800, 3)
-    assert ms < 250  # loose bound for a loaded 2-core machine; about 15 ms measured when idle
     r.close()
 
 

@@ -1,10 +1,10 @@
-"""The yaw-departure figures of the README ("Known limitation: yaw departures at large
-sideslip"), measured by aerostat_gym.analysis.sideslip (scripts/sideslip_departures.py)."""
+"""The sideslip figures of the README ("Large-angle fins, sideslip and the air-inertia force"),
+measured by aerostat_gym.agents.sideslip (scripts/sideslip_departures.py)."""
 
 import numpy as np
 import pytest
 
-from aerostat_gym.analysis import sideslip as script
+from aerostat_gym.agents import sideslip as script
 
 
 def test_sideslip_closed_form():
@@ -18,12 +18,13 @@ def test_sideslip_closed_form():
 
 
 def test_static_yaw_moment_sign_structure():
-    """At 8 m/s with the baseline stall angle (16 deg), the static yaw moment restores at yaw
-    offsets of 5-15 deg and turns divergent at 20-60 deg (the flat post-stall fin lift); with a
-    45 deg stall angle it restores at every offset (exact signs, as the README states)."""
-    curve16 = dict(zip(script.OFFSETS_DEG, script.yaw_curve(16.0), strict=True))
-    curve45 = script.yaw_curve(45.0)
-    assert all(curve16[d] < 0 for d in (5, 10, 15))
-    assert all(curve16[d] > 0 for d in (20, 30, 45, 60))
-    assert curve16[80] < 0  # the second, side-on equilibrium lies between 60 and 80 deg
-    assert all(v < 0 for v in curve45)
+    """At 8 m/s with [LN02]'s flat post-stall lift and the 2-D stall angle (16 deg), the static
+    yaw moment restores at yaw offsets of 5-15 deg and turns divergent at 20-60 deg; with the
+    baseline fins (Viterna-Corrigan beyond a 45 deg stall) it restores at every offset to
+    90 deg (exact signs)."""
+    flat = dict(zip(script.OFFSETS_DEG,
+                    script.yaw_curve(8.0, {"fins.post_stall": "flat", "fins.alpha_stall_deg": 16.0}),
+                    strict=True))
+    assert all(flat[d] < 0 for d in (5, 10, 15))
+    assert all(flat[d] > 0 for d in (20, 30, 45, 60))
+    assert all(v < 0 for v in script.yaw_curve(8.0))

@@ -18,8 +18,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..envs.config import DEFAULT_WIND_RANGE
 from ..envs.spaces import CHANNELS, N_OBS, OBS_TENSION
 from ..envs.vector import TetheredAerostatVectorEnv
+from ..params import dumps_toml, load_params
 from .metrics import response_metrics
 from .policies import load_policy
 from .sb3io import PolicyError
@@ -121,13 +123,23 @@ def episode_metrics(ep: Episodes, i: int) -> dict:
 
 
 def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float = 0.2,
-             params=None) -> dict:
-    """Metrics of one policy on a suite: {scenario: [per-episode metrics]}, plus the score."""
+                    params=None) -> dict:
+    """Metrics of one policy on a suite: {scenario: [per-episode metrics]}, plus the score.
+
+    ``params`` (a Params, a TOML path, a shipped configuration's name or None for the baseline)
+    is the configuration of both the baselines' design and the environment the suite runs on;
+    the resolved parameters are recorded in the result (``params_toml``).
+    """
     spec = check_suite(suite)
-    policy = load_policy(policy_name, params=params, dt=control_step)
-    out, returns = {"policy": policy_name, "suite": suite, "scenarios": {}}, []
+    params = params if params is not None and not isinstance(params, str) else load_params(params)
+    policy = load_policy(policy_name, params=params, dt=control_step,
+                         wind_range=DEFAULT_WIND_RANGE)
+    out = {"policy": policy_name, "suite": suite, "scenarios": {},
+           "tether_length_m": params.tether.length, "params_toml": dumps_toml(params)}
+    returns = []
     for scenario, (speeds, seeds) in spec.items():
-        ep = run_scenario(policy, scenario, speeds, seeds, control_step)
+        ep = run_scenario(policy, scenario, speeds, seeds, control_step,
+                          env_kwargs={"params": params})
         rows = [episode_metrics(ep, i) for i in range(len(ep.speeds))]
         if hasattr(policy, "predicted_modes"):
             for r in rows:
@@ -138,9 +150,12 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
     return out
 
 
-def suite_score(policy, suite: str = "tiny", control_step: float = 0.2) -> float:
-    """Mean episode return of a policy object on a suite (the training curve's measure)."""
+def suite_score(policy, suite: str = "tiny", control_step: float = 0.2, params=None) -> float:
+    """Mean episode return of a policy object on a suite (the training curve's measure), in
+    the environment of ``params`` (default: the baseline)."""
     returns = []
+    kwargs = None if params is None else {"params": params}
     for scenario, (speeds, seeds) in check_suite(suite).items():
-        returns.extend(run_scenario(policy, scenario, speeds, seeds, control_step).returns)
+        returns.extend(run_scenario(policy, scenario, speeds, seeds, control_step,
+                                    env_kwargs=kwargs).returns)
     return float(np.mean(returns))

@@ -80,14 +80,35 @@ LQR_MAX_DEVIATIONS: dict[str, float | None] = {
     "pitch_rate": 0.05,  # rad/s
     "yaw_rate": 0.05,  # rad/s
     "length": 5.0,  # m, paid-out tether length
-    "reel_speed": 1.0,  # m/s, winch reel speed v_w
+    "reel_speed": None,  # m/s, winch reel speed v_w (None: params.winch.max_speed)
     "length_integral": 50.0,  # m s, integral of the length error
     "v_set": None,  # m/s, set-point (None: params.winch.max_speed)
 }
+#: The deviations above are for the 300 m baseline tether. For another configuration the
+#: positions (and the length integral) scale with tether.length / WEIGHTS_REFERENCE_LENGTH and
+#: the velocities and rates with its square root, as the pendulum's amplitude and frequency do
+#: (omega ~ sqrt(g' / L)); angles are not scaled. The baseline's weights are unchanged.
+WEIGHTS_REFERENCE_LENGTH = 300.0
+_POSITION_WEIGHTS = ("node_pos", "cm_pos", "length", "length_integral")
+_VELOCITY_WEIGHTS = ("node_vel", "cm_vel", "roll_rate", "pitch_rate", "yaw_rate")
 
-#: Design wind speeds of the default schedule [m/s] (2, 3, ..., 16).
+#: Design wind speeds of the default schedule [m/s] (2, 3, ..., 16): the environment's default
+#: range 3-15 m/s with one step of margin on each side (:func:`schedule_speeds`).
 DEFAULT_SPEEDS = np.arange(2.0, 17.0, 1.0)
 DEFAULT_SPEEDS.setflags(write=False)
+#: Step of the design speeds and the margin beyond the wind range [m/s].
+SCHEDULE_STEP = 1.0
+
+
+def schedule_speeds(wind_range: tuple[float, float]) -> np.ndarray:
+    """Design speeds covering a wind range (low, high) [m/s] with one step of margin on each
+    side, never below 1 m/s (at zero wind the yaw mode is neutral); (3, 15) gives 2, 3, ..., 16."""
+    lo, hi = (float(v) for v in wind_range)
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo <= hi):
+        raise ValueError(f"wind range must be finite with 0 <= low <= high, got {wind_range!r}")
+    start = max(lo - SCHEDULE_STEP, 1.0)
+    n = int(math.ceil((hi + SCHEDULE_STEP - start) / SCHEDULE_STEP - 1e-9)) + 1
+    return start + SCHEDULE_STEP * np.arange(n)
 
 #: Long-period/short-period modes reported by :meth:`LQRDesign.summary`.
 NAMED_MODES = ("pendulum", "pitching", "axial spring")
@@ -97,14 +118,26 @@ class LQRDesignError(RuntimeError):
     """The Riccati equation could not be solved or the loop it gives is not stable."""
 
 
-def _weights(params: Params, weights: dict | None) -> dict:
+def scaled_deviations(params: Params) -> dict:
+    """:data:`LQR_MAX_DEVIATIONS` for the configured tether and winch (see
+    :data:`WEIGHTS_REFERENCE_LENGTH`); the reel speed and set-point at winch.max_speed."""
+    r = params.tether.length / WEIGHTS_REFERENCE_LENGTH
     w = dict(LQR_MAX_DEVIATIONS)
+    for k in _POSITION_WEIGHTS:
+        w[k] = w[k] * r
+    for k in _VELOCITY_WEIGHTS:
+        w[k] = w[k] * math.sqrt(r)
+    for k in ("reel_speed", "v_set"):
+        w[k] = float(params.winch.max_speed)
+    return w
+
+
+def _weights(params: Params, weights: dict | None) -> dict:
+    w = scaled_deviations(params)
     for k, v in (weights or {}).items():
         if k not in w:
             raise ValueError(f"unknown LQR weight {k!r}; known: {', '.join(w)}")
         w[k] = v
-    if w["v_set"] is None:
-        w["v_set"] = float(params.winch.max_speed)
     for k, v in w.items():
         if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
             raise ValueError(f"LQR weight {k!r} must be a finite positive deviation, got {v!r}")
@@ -414,6 +447,15 @@ class LQRSchedule:
 
     def __init__(self, params: Params, speeds=None, dt: float = 0.2,
                  weights: dict | None = None, *, subset: str = "auto"):
+        designs = self._build(params, speeds, dt, lambda U, eq: design_lqr(
+            params, U, dt, weights, equilibrium=eq, subset=subset))
+        self.weights = designs[0].weights
+        self.subsets = [d.subset for d in designs]
+
+    def _build(self, params: Params, speeds, dt: float, design_at) -> list:
+        """Design at every speed (``design_at(U, equilibrium)``, trims by continuation in U)
+        and fill the tables; returns the designs. Subclasses with another design rule (the
+        modal controller) reuse it."""
         speeds = np.asarray(DEFAULT_SPEEDS if speeds is None else speeds, float).ravel()
         if speeds.size == 0 or np.any(np.diff(speeds) <= 0) or np.any(speeds < 0):
             raise ValueError(f"speeds must be non-negative and strictly increasing, got {speeds}")
@@ -421,15 +463,12 @@ class LQRSchedule:
         designs, eq = [], None
         for U in speeds:
             eq = find_equilibrium(params, float(U), guess=eq)
-            designs.append(design_lqr(params, float(U), dt, weights, equilibrium=eq,
-                                      subset=subset))
+            designs.append(design_at(float(U), eq))
         self.build_time_s = time.perf_counter() - t0
         self.params = params
         self.fingerprint = params_fingerprint(params)
         self.speeds = speeds
         self.dt = float(dt)
-        self.weights = designs[0].weights
-        self.subsets = [d.subset for d in designs]
         self.gains = np.array([d.K for d in designs])
         self.trims = np.array([d.x_trim for d in designs])
         self.pendulum_zeta = np.array([[d.summary()["pendulum"][k]["zeta"] for k in ("open", "closed")]
@@ -437,6 +476,7 @@ class LQRSchedule:
         self.pitch_zeta = np.array([[d.summary()["pitching"][k]["zeta"] for k in ("open", "closed")]
                                     for d in designs])
         self.designs = designs
+        return designs
 
     # --- lookup -----------------------------------------------------------------------------
 
@@ -510,7 +550,10 @@ class LQRPolicy:
     dt : float
         Control step [s] (must match the schedule's).
     schedule : LQRSchedule, optional
-        The gain table (default: built here, a few seconds).
+        The gain table (default: built here, a few seconds, over ``wind_range``).
+    wind_range : (float, float), optional
+        Wind speeds [m/s] the schedule must cover (default: :data:`DEFAULT_SPEEDS`, for the
+        environment's default 3-15 m/s); see :func:`schedule_speeds`.
     privileged : bool
         True (the only mode implemented): the policy reads the exact state deviation and the
         episode's mean wind speed from the ``observation="full"`` vector.
@@ -525,13 +568,16 @@ class LQRPolicy:
     """
 
     def __init__(self, params: Params, dt: float = 0.2, schedule: LQRSchedule | None = None,
-                 privileged: bool = True):
+                 privileged: bool = True, wind_range: tuple[float, float] | None = None):
         if not privileged:
             raise NotImplementedError("LQRPolicy needs the privileged full-state observation "
                                       "(privileged=True); output feedback is not implemented")
         self.params = params
         self.dt = float(dt)
-        self.schedule = schedule if schedule is not None else LQRSchedule(params, dt=dt)
+        if schedule is None:
+            speeds = None if wind_range is None else schedule_speeds(wind_range)
+            schedule = LQRSchedule(params, speeds=speeds, dt=dt)
+        self.schedule = schedule
         if abs(self.schedule.dt - self.dt) > 1e-12:
             raise ValueError(f"schedule was designed for dt = {self.schedule.dt} s, policy "
                              f"dt = {self.dt} s")

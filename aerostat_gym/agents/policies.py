@@ -18,12 +18,23 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.reference import reference_periods
 from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION
-from ..params import load_params
+from ..params import Params, load_params
+from ..resources import SHIPPED_POLICY, shipped_path
+from .lqg import LQGPolicy
 from .lqr import LQRPolicy
+from .modal import ModalPolicy
 from .sb3io import PolicyError, as_batch, load_sb3, to_actions
 
-BASELINES = ("passive", "tension", "lqr")
+BASELINES = ("passive", "tension", "lqr", "modal", "lqg")
+#: Names of trained policies that ship with the package.
+SHIPPED = {"shipped": SHIPPED_POLICY}
+#: Tension feedback in units of the configuration: reel speed per tension excess, as a fraction
+#: of winch.max_speed per net lift (the baseline's 0.3 m/s per kN x 2.645 kN / 1 m/s), and the
+#: length-restoring time in longitudinal pendulum periods (the baseline's 60 s / 43.64 s).
+GAIN_PER_NET_LIFT = 0.3 * 2.6447
+RESTORE_PENDULUM_PERIODS = 60.0 / 43.64
 
 
 class PassivePolicy:
@@ -53,6 +64,24 @@ class TensionFeedbackPolicy:
             raise ValueError("tension feedback needs gain >= 0, restore_time > 0, max_speed > 0")
         self.gain, self.restore_time, self.max_speed = gain, restore_time, max_speed
 
+    @classmethod
+    def for_params(cls, params: Params) -> TensionFeedbackPolicy:
+        """The tension feedback designed for the configured aerostat and winch.
+
+        Notes
+        -----
+        The baseline's gains (0.3 m/s per kN, 60 s, 1 m/s) in the configuration's own units: a
+        tension excess of one net lift B - m g asks for GAIN_PER_NET_LIFT times the winch's
+        speed limit, and the length restores over RESTORE_PENDULUM_PERIODS of the
+        longitudinal pendulum's closed-form period; the speed limit is winch.max_speed. For
+        the baseline (2645 N, 43.6 s, 1 m/s) this gives 0.30 m/s per kN and 60 s again.
+        """
+        d = params.derived
+        v_max = float(params.winch.max_speed)
+        gain = GAIN_PER_NET_LIFT * v_max / (d.net_lift / 1.0e3)
+        restore = RESTORE_PENDULUM_PERIODS * reference_periods(params)["long_pendulum"]
+        return cls(gain=gain, restore_time=restore, max_speed=v_max)
+
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs, single = as_batch(observation)
         dT_kN = obs[:, OBS_DTENSION] * CHANNELS[OBS_DTENSION].scale / 1.0e3
@@ -61,14 +90,30 @@ class TensionFeedbackPolicy:
         return to_actions(v / self.max_speed, single), state
 
 
-def load_policy(name: str, params=None, dt: float = 0.2):
-    """A baseline by name ('passive', 'tension', 'lqr') or a saved SB3 model (path to .zip)."""
+def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
+                obs_noise: float = 0.0):
+    """A baseline by name designed for ``params`` (default: the baseline), a shipped trained
+    policy by name ('shipped': the package's default PPO policy) or a saved SB3 model (.zip).
+
+    Baselines: 'passive' (braked winch), 'tension' (tension feedback), 'lqr' (gain-scheduled
+    LQR over the wind range, privileged full state), 'modal' (pendulum pole placement,
+    privileged full state), 'lqg' (Kalman filter on the standard channels designed for the
+    sensor noise ``obs_noise``, with the LQR gains).
+    """
+    params = params or load_params()
     if name == "passive":
         return PassivePolicy()
     if name == "tension":
-        return TensionFeedbackPolicy()
+        return TensionFeedbackPolicy.for_params(params)
     if name == "lqr":
-        return LQRPolicy(params or load_params(), dt=dt)
+        return LQRPolicy(params, dt=dt, wind_range=wind_range)
+    if name == "modal":
+        return ModalPolicy(params, dt=dt)
+    if name == "lqg":
+        return LQGPolicy(params, dt=dt, obs_noise=obs_noise)
+    if name in SHIPPED:
+        return load_sb3(shipped_path(SHIPPED[name]))
     if name.endswith(".zip") or Path(name).exists():
         return load_sb3(name)
-    raise PolicyError(f"unknown policy {name!r}: use one of {BASELINES} or a path to a .zip")
+    raise PolicyError(f"unknown policy {name!r}: use one of {BASELINES + tuple(SHIPPED)} or a "
+                      "path to a .zip")

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..resources import SHIPPED_POLICY
 from .evaluate import SUITES, evaluate_policy
 
 COLUMNS = [  # (key, header, format)
@@ -145,11 +146,12 @@ def plot(results: list[dict], out: Path) -> list[Path]:
 
 
 def write_report(results: list[dict], out: str | Path, title: str, command: str,
-                 plots: bool = True) -> Path:
-    """Write report.md, report.json and the PNGs into ``out``; returns the Markdown path."""
+                 plots: bool = True, preamble: list[str] | None = None) -> Path:
+    """Write report.md, report.json and the PNGs into ``out``; returns the Markdown path.
+    ``preamble``: Markdown lines placed after the command line (e.g. the demo's summary)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    parts = [f"# {title}", "", f"Command: `{command}`", "",
+    parts = [f"# {title}", "", f"Command: `{command}`", "", *(preamble or []),
              f"Suite `{results[0]['suite']}`: {json.dumps(SUITES[results[0]['suite']])} "
              "(scenario: (wind speeds, seeds)). Control step 0.2 s.", "",
              "Scores (mean episode return, default reward): " +
@@ -165,6 +167,9 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
     if plots:
         for p in plot(results, out):
             parts += [f"![{p.stem}]({p.name})", ""]
+    if "params_toml" in results[0]:
+        (out / "params.toml").write_text(results[0]["params_toml"])
+        parts += [f"Parameters: `params.toml` (tether {results[0]['tether_length_m']:g} m).", ""]
     md = out / "report.md"
     md.write_text("\n".join(parts))
     (out / "report.json").write_text(json.dumps(jsonable(results), indent=1))
@@ -180,11 +185,14 @@ def jsonable(results: list[dict]) -> list[dict]:
     return out
 
 
-def run_evaluations(policies: list[str], suite: str, progress: bool = True) -> list[dict]:
+def run_evaluations(policies: list[str], suite: str, progress: bool = True,
+                    params=None) -> list[dict]:
+    """Evaluate every policy on ``suite`` in the environment of ``params`` (default baseline)."""
     results = []
     for name in _progress(policies, progress, "evaluating"):
-        r = evaluate_policy(name, suite)
-        r["label"] = Path(name).stem if name.endswith(".zip") else name
+        r = evaluate_policy(name, suite, params=params)
+        r["label"] = Path(name).stem if name.endswith(".zip") else (
+            Path(SHIPPED_POLICY).stem if name == "shipped" else name)
         results.append(r)
     return results
 

@@ -8,6 +8,7 @@ functions that need it.
 from __future__ import annotations
 
 import pickle
+import warnings
 import zipfile
 from pathlib import Path
 
@@ -100,6 +101,10 @@ def load_sb3(path: str | Path) -> SB3Policy:
         with open(stats, "rb") as fh:
             norm = pickle.load(fh)
         norm.training = False
+    else:
+        warnings.warn(f"no VecNormalize statistics beside {path} (looked for {stats.name}): the "
+                      "policy sees raw observations, which is wrong if it was trained with "
+                      "normalisation", stacklevel=2)
     shape = model.observation_space.shape
     if len(shape) != 1 or shape[0] < N_OBS:
         raise PolicyError(f"{path} was trained on observations of shape {shape}; "

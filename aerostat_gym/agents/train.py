@@ -1,17 +1,21 @@
 """``aerostat-gym train``: Stable-Baselines3 training on the native batched environment.
 
-Hyperparameters come from rl-baselines3-zoo style YAML (one block per environment id; keys:
-``n_timesteps``, ``n_envs``, ``policy``, ``normalize`` (bool or VecNormalize kwargs),
-``policy_kwargs`` (a mapping), ``env_kwargs``, ``eval_freq``, ``eval_suite``, ``noise_type`` /
-``noise_std`` for TD3, the rest passed to the algorithm). Each run directory holds the resolved
-parameter TOML, the hyperparameters, the command, the package version, TensorBoard logs,
-checkpoints (model + VecNormalize statistics), the best model on the fixed evaluation suite
-and the final model.
+Hyperparameters come from rl-baselines3-zoo YAML that the zoo itself reads unchanged: a block
+per registered task id (keys ``n_timesteps``, ``n_envs``, ``policy``, ``normalize`` (a bool or
+the zoo's string ``"dict(norm_obs=..., norm_reward=...)"``; the discount ``gamma`` is added, as
+the zoo does), ``policy_kwargs``, ``noise_type`` / ``noise_std`` for TD3, the rest passed to the
+algorithm), trained on that task's registered conditions. Keys the zoo does not know live in a
+separate top-level block ``aerostat_gym`` (``eval_freq``, ``eval_suite``, ``env_kwargs``).
+Each run directory holds the resolved parameter TOML, the hyperparameters, the command, the
+package version, TensorBoard logs, checkpoints (model + VecNormalize statistics), the best
+model on the fixed evaluation suite and the final model.
 """
 
 from __future__ import annotations
 
+import ast
 import json
+import math
 import platform
 import shlex
 import sys
@@ -23,40 +27,70 @@ import numpy as np
 from .. import __version__
 from ..envs.sb3 import sb3_vec_env
 from ..params import dumps_toml
-from ..registration import ENV_ID
+from ..registration import TASKS
+from ..resources import shipped_path
 from .evaluate import check_suite, suite_score
 from .sb3io import SB3Policy, save_model, vecnormalize_path
 
 ALGOS = ("ppo", "sac", "td3")
-HYPERPARAMS_DIR = Path("agents/hyperparams")
-RESERVED = {"n_timesteps", "n_envs", "policy", "normalize", "env_kwargs", "eval_freq",
-            "eval_suite", "noise_type", "noise_std", "policy_kwargs"}
+#: Keys of a zoo block that configure the run rather than the algorithm's constructor.
+RESERVED = {"n_timesteps", "n_envs", "policy", "normalize", "noise_type", "noise_std",
+            "policy_kwargs"}
+PROJECT_BLOCK = "aerostat_gym"
+PROJECT_KEYS = {"eval_freq", "eval_suite", "env_kwargs"}
 
 
 class TrainingError(ValueError):
     """Bad training configuration (the message names the key or file)."""
 
 
-def load_hyperparams(algo: str, path: str | Path | None = None) -> dict:
-    """The block for ``TetheredAerostat-v0`` in the YAML file (default agents/hyperparams/ALGO.yml,
-    falling back to the copy shipped in the package)."""
+def load_hyperparams(algo: str, path: str | Path | None = None) -> tuple[str, dict, dict]:
+    """(task id, zoo block, project block) of a hyperparameter YAML file (default: the shipped
+    ``hyperparams/ALGO.yml``). The zoo block is the one keyed by a registered task id."""
     import yaml
 
     if algo not in ALGOS:
         raise TrainingError(f"unknown algorithm {algo!r}; choose one of {ALGOS}")
-    if path is None:
-        path = HYPERPARAMS_DIR / f"{algo}.yml"
-        if not path.is_file():
-            from importlib import resources
-
-            path = Path(str(resources.files("aerostat_gym").joinpath(f"data/hyperparams/{algo}.yml")))
-    path = Path(path)
+    path = shipped_path("hyperparams", f"{algo}.yml") if path is None else Path(path)
     if not path.is_file():
         raise TrainingError(f"hyperparameter file not found: {path}")
     data = yaml.safe_load(path.read_text()) or {}
-    if ENV_ID not in data:
-        raise TrainingError(f"{path} has no block for {ENV_ID!r} (found {sorted(data)})")
-    return dict(data[ENV_ID])
+    tasks = [k for k in data if k in TASKS]
+    if len(tasks) != 1:
+        raise TrainingError(f"{path} needs exactly one block keyed by a task id of "
+                            f"{sorted(TASKS)}, found {sorted(data)}")
+    project = dict(data.get(PROJECT_BLOCK) or {})
+    unknown = sorted(set(project) - PROJECT_KEYS)
+    if unknown:
+        raise TrainingError(f"{path}: unknown key(s) {unknown} in the {PROJECT_BLOCK!r} block; "
+                            f"known: {sorted(PROJECT_KEYS)}")
+    return tasks[0], dict(data[tasks[0]]), project
+
+
+def normalize_kwargs(hp: dict) -> dict | None:
+    """VecNormalize keyword arguments of a zoo block (None: no normalisation).
+
+    ``normalize`` is a bool or the zoo's string ``"dict(norm_obs=True, norm_reward=False)"``
+    (read here with ``ast``, never evaluated); the block's ``gamma`` is added, as the zoo does.
+    """
+    value = hp.get("normalize", False)
+    if isinstance(value, str):
+        try:
+            call = ast.parse(value, mode="eval").body
+            if not (isinstance(call, ast.Call) and getattr(call.func, "id", None) == "dict"
+                    and not call.args):
+                raise ValueError
+            kw = {k.arg: ast.literal_eval(k.value) for k in call.keywords}
+        except (SyntaxError, ValueError):
+            raise TrainingError(f"normalize must be true, false or \"dict(key=value, ...)\", "
+                                f"got {value!r}") from None
+    elif isinstance(value, bool):
+        kw = {} if value else None
+    else:
+        raise TrainingError(f"normalize must be true, false or \"dict(...)\", got {value!r}")
+    if kw is not None and "gamma" in hp:
+        kw["gamma"] = hp["gamma"]
+    return kw
 
 
 def _algorithm(algo: str):
@@ -65,59 +99,72 @@ def _algorithm(algo: str):
     return {"ppo": PPO, "sac": SAC, "td3": TD3}[algo]
 
 
-def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize):
-    """The SB3 VecEnv over one compiled batch, wrapped in VecMonitor and VecNormalize."""
+def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict | None):
+    """The SB3 VecEnv over one compiled batch, wrapped in VecMonitor and (with VecNormalize
+    keyword arguments) VecNormalize."""
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     venv = VecMonitor(sb3_vec_env(n_envs, seed=seed, **env_kwargs))
-    if normalize:
-        kw = normalize if isinstance(normalize, dict) else {}
-        venv = VecNormalize(venv, **kw)
+    if normalize is not None:
+        venv = VecNormalize(venv, **normalize)
     return venv
 
 
 def _count(name: str, value) -> int:
     """A step or environment count: an integer >= 1 (0 and negatives are refused, not read as
     'use the default')."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value) \
-            or value < 1:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+            or value != int(value) or value < 1:
         raise TrainingError(f"{name} must be an integer >= 1, got {value!r}")
     return int(value)
 
 
-def train(algo: str, config: str | Path | None = None, timesteps: int | None = None,
+def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | None = None,
           n_envs: int | None = None, seed: int = 0, run_dir: str | Path | None = None,
           resume: str | Path | None = None, progress_bar: bool = True, threads: int | None = None,
-          eval_freq: int | None = None) -> Path:
-    """Train and return the run directory (see the module docstring)."""
+          eval_freq: int | None = None, params=None, on_eval=None) -> Path:
+    """Train and return the run directory (see the module docstring).
+
+    ``hyperparams`` is the YAML file (default: the shipped one for ``algo``); ``params`` the
+    physics configuration (a Params, a TOML path or a shipped name; default the baseline), used
+    by the training environments and the suite evaluations and written to ``params.toml`` in
+    the run directory. ``on_eval(record, run)``, if given, is called after every suite
+    evaluation (``record`` as in evaluations.json, plus ``"best"``: whether best_model.zip was
+    just saved).
+    """
     import torch
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
     from stable_baselines3.common.utils import set_random_seed
 
-    hp = load_hyperparams(algo, config)
+    task_id, hp, project = load_hyperparams(algo, hyperparams)
     n_envs = _count("n_envs", hp.get("n_envs", 8) if n_envs is None else n_envs)
     timesteps = _count("timesteps", hp.get("n_timesteps", 1e6) if timesteps is None else timesteps)
-    env_kwargs = dict(hp.get("env_kwargs") or {})
+    env_kwargs = {**TASKS[task_id][0], **(project.get("env_kwargs") or {})}
+    if params is not None:
+        env_kwargs["params"] = params
     run = Path(run_dir or f"runs/train/{algo}_seed{seed}_{time.strftime('%Y%m%d-%H%M%S')}")
     run.mkdir(parents=True, exist_ok=True)
     if threads:
         torch.set_num_threads(threads)
     set_random_seed(seed)
-    venv = make_training_env(n_envs, seed, env_kwargs, hp.get("normalize", False))
-    _write_run_files(run, algo, hp, venv, seed, n_envs, timesteps)
+    venv = make_training_env(n_envs, seed, env_kwargs, normalize_kwargs(hp))
+    _write_run_files(run, algo, task_id, {task_id: hp, PROJECT_BLOCK: project}, venv, seed,
+                     n_envs, timesteps)
     model = _model(algo, hp, venv, seed, run, resume)
-    freq = int(eval_freq or hp.get("eval_freq", 50_000))
+    freq = int(eval_freq or project.get("eval_freq", 50_000))
     callbacks = CallbackList([
         CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"), name_prefix=algo,
                            save_vecnormalize=True),
-        suite_eval_callback(hp.get("eval_suite", "tiny"), max(freq // n_envs, 1), run),
+        suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1), run,
+                            env_kwargs.get("params"), on_eval),
     ])
     t0 = time.perf_counter()
     model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress_bar,
                 reset_num_timesteps=resume is None, tb_log_name=algo)
     wall = time.perf_counter() - t0
     save_model(model, run / f"{algo}_final.zip")
-    summary = {"algo": algo, "timesteps": timesteps, "n_envs": n_envs, "seed": seed,
+    summary = {"algo": algo, "task": task_id, "timesteps": timesteps, "n_envs": n_envs,
+               "seed": seed,
                "wall_time_s": wall, "steps_per_s": timesteps / wall,
                "machine": platform.processor() or platform.machine(),
                "threads": torch.get_num_threads()}
@@ -126,7 +173,7 @@ def train(algo: str, config: str | Path | None = None, timesteps: int | None = N
     return run
 
 
-def suite_eval_callback(suite: str, freq: int, run: Path):
+def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=None):
     """A callback that, every ``freq`` calls, scores the current policy on the fixed suite
     (deterministic actions, the training VecNormalize statistics), logs it, appends it to
     ``evaluations.json`` and saves the best-scoring model (with its statistics) as
@@ -150,14 +197,18 @@ def suite_eval_callback(suite: str, freq: int, run: Path):
                 self.evaluate_now()
 
         def evaluate_now(self) -> None:
-            score = suite_score(SB3Policy(self.model, self.model.get_env()), suite)
+            score = suite_score(SB3Policy(self.model, self.model.get_env()), suite,
+                                params=params)
             self.logger.record("eval/suite_score", score)
             self.history.append({"timesteps": int(self.num_timesteps), "score": score,
                                  "wall_time_s": time.perf_counter() - self.t0})
             (Path(run) / "evaluations.json").write_text(json.dumps(self.history, indent=1))
-            if score > self.best:
+            best = score > self.best
+            if best:
                 self.best = score
                 save_model(self.model, Path(run) / "best_model.zip")
+            if on_eval is not None:
+                on_eval({**self.history[-1], "best": best}, Path(run))
 
     return SuiteEvalCallback()
 
@@ -207,16 +258,28 @@ def _load_vecnormalize_into(checkpoint: Path, venv):
     return venv
 
 
-def _write_run_files(run, algo, hp, venv, seed, n_envs, timesteps):
+def _write_run_files(run, algo, task_id, blocks, venv, seed, n_envs, timesteps):
     import yaml
 
     base = venv
     while hasattr(base, "venv"):
         base = base.venv
     (run / "params.toml").write_text(dumps_toml(base.task.params_resolved))
-    (run / "hyperparams.yml").write_text(yaml.safe_dump({ENV_ID: hp}, sort_keys=False))
-    (run / "command.txt").write_text(" ".join(shlex.quote(a) for a in sys.argv) + "\n")
+    (run / "hyperparams.yml").write_text(yaml.safe_dump(blocks, sort_keys=False))
+    (run / "command.txt").write_text(recorded_command() + "\n")
     (run / "version.json").write_text(json.dumps({
         "aerostat_gym": __version__, "python": platform.python_version(), "algo": algo,
-        "seed": seed, "n_envs": n_envs, "timesteps": timesteps}, indent=2))
+        "task": task_id, "seed": seed, "n_envs": n_envs, "timesteps": timesteps}, indent=2))
 
+
+def recorded_command() -> str:
+    """The command line as run, with the program as its name (``aerostat-gym``, not an
+    absolute path) and paths inside the working directory made relative."""
+    cwd = Path.cwd()
+    args = []
+    for a in sys.argv[1:]:
+        p = Path(a)
+        if p.is_absolute() and p.is_relative_to(cwd):
+            a = str(p.relative_to(cwd))
+        args.append(a)
+    return " ".join(shlex.quote(a) for a in ["aerostat-gym", *args])

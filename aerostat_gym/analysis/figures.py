@@ -127,19 +127,24 @@ def compare_responses(params: Params, lin, x0: np.ndarray, duration: float,
     return out
 
 
-def _figure8_setup(params: Params | None, wind_speed: float, length: float):
-    """The parameters with the tether length set, and the linear model at their trim."""
-    p = (params or load_params()).replace(**{"tether.length": length})
+def _figure8_setup(params: Params | None, wind_speed: float, length: float | None):
+    """The parameters (tether length set if ``length`` is given; default the configured one)
+    and the linear model at their trim."""
+    p = params or load_params()
+    if length is not None and length != p.tether.length:
+        p = p.replace(**{"tether.length": length})
     return p, linearize(p, find_equilibrium(p, wind_speed))
 
 
-def figure8_data(params: Params | None = None, wind_speed: float = 10.0, length: float = 300.0,
+def figure8_data(params: Params | None = None, wind_speed: float = 10.0, length: float | None = None,
                  duration: float = 80.0, output_dt: float = 0.1, scale: float = 1.0,
                  tether_nodes: str = "trim") -> dict:
-    """Linear and nonlinear responses to the Figure 8 perturbation (L = 300 m, U = 10 m/s).
+    """Linear and nonlinear responses to the Figure 8 perturbation (U = 10 m/s; [LN02] used
+    its 300 m baseline tether).
 
     Parameters
     ----------
+    length : tether length [m] (default: the configured ``tether.length``).
     scale : multiplies the [LN02] amplitudes (0.1 m, 0.01 rad). tether_nodes : see
         :func:`figure8_initial_state`.
 
@@ -152,14 +157,14 @@ def figure8_data(params: Params | None = None, wind_speed: float = 10.0, length:
     p, lin = _figure8_setup(params, wind_speed, length)
     x0 = figure8_initial_state(lin, 0.1 * scale, 0.01 * scale, tether_nodes)
     out = compare_responses(p, lin, x0, duration, output_dt)
-    out.update(wind_speed_m_s=wind_speed, tether_length_m=length, scale=scale,
+    out.update(wind_speed_m_s=wind_speed, tether_length_m=p.tether.length, scale=scale,
                tether_nodes=tether_nodes)
     return out
 
 
 def figure8_amplitude_scan(params: Params | None = None, scales=(1.0, 0.5, 0.3, 0.2, 0.1),
                            tether_nodes=TETHER_NODES, wind_speed: float = 10.0,
-                           length: float = 300.0, duration: float = 80.0) -> list[dict]:
+                           length: float | None = None, duration: float = 80.0) -> list[dict]:
     """nRMS per variable against the perturbation amplitude (fraction of [LN02]'s) for each
     tether-node choice. A linearization error would not shrink with the amplitude; a nonlinear
     effect shrinks in proportion (quadratic terms) or faster."""
@@ -174,7 +179,7 @@ def figure8_amplitude_scan(params: Params | None = None, scales=(1.0, 0.5, 0.3, 
 
 
 def figure8_decomposition(params: Params | None = None, wind_speed: float = 10.0,
-                          length: float = 300.0, duration: float = 80.0,
+                          length: float | None = None, duration: float = 80.0,
                           tether_nodes: str = "trim") -> list[dict]:
     """Split the nonlinear Figure 8 response into its parts odd and even in the kick.
 
@@ -213,7 +218,7 @@ FIG8_HEADINGS = {"wind toward +X (package frame)": 0.0,
 
 
 def figure8_readings(params: Params | None = None, wind_speed: float = 10.0,
-                     length: float = 300.0, duration: float = 80.0) -> list[dict]:
+                     length: float | None = None, duration: float = 80.0) -> list[dict]:
     """nRMS of every variable for each reading of the Figure 8 kick the paper leaves open:
     the axes' directions (:data:`FIG8_HEADINGS`) times the tether nodes (:data:`TETHER_NODES`);
     with the confluence-tension swing each reading causes."""
@@ -373,16 +378,32 @@ def write_figure8(out_dir: str | Path, params: Params | None = None) -> dict:
 # --- tether length and trim pitch families ------------------------------------------------------
 
 #: Families discussed by [LN02] ("changing various system parameters such as tether length and
-#: steady state pitch angle"): dotted parameter name -> values.
+#: steady state pitch angle"), relative to the configuration: tether length as fractions of the
+#: configured length (the baseline's 150, 225, 300, 375 m), trim pitch as offsets from the
+#: configured pitch [deg] (the baseline's -8, -4, 0 deg).
 FAMILIES = {
-    "tether.length": (150.0, 225.0, 300.0, 375.0),
-    "aerostat.trim_pitch_deg": (-8.0, -4.0, 0.0),
+    "tether.length": ("scale", (0.5, 0.75, 1.0, 1.25)),
+    "aerostat.trim_pitch_deg": ("offset", (-4.0, 0.0, 4.0)),
 }
 
 
-def family_data(params: Params | None, name: str, values, speeds=None) -> dict:
-    """Figure 9 data for each value of one parameter: {value: figure9_data}."""
+def family_values(params: Params, name: str) -> tuple[float, ...]:
+    """The values of one family for ``params``: scaled or offset from the configured value;
+    lengths are kept inside the winch's limits (a length outside them is refused on loading)."""
+    kind, steps = FAMILIES[name]
+    sec, key = name.split(".")
+    base = float(getattr(getattr(params, sec), key))
+    values = [base * v for v in steps] if kind == "scale" else [base + v for v in steps]
+    if name == "tether.length":
+        values = [min(max(v, params.winch.min_length), params.winch.max_length) for v in values]
+    return tuple(dict.fromkeys(round(v, 9) for v in values))
+
+
+def family_data(params: Params | None, name: str, values=None, speeds=None) -> dict:
+    """Figure 9 data for each value of one parameter: {value: figure9_data} (values default to
+    :func:`family_values` of the configuration)."""
     base = params or load_params()
+    values = family_values(base, name) if values is None else values
     speeds = np.arange(0.0, 20.0 + 1e-9, 1.0) if speeds is None else speeds
     return {float(v): figure9_data(wind_sweep(base.replace(**{name: v}), speeds)) for v in values}
 
@@ -422,8 +443,8 @@ def write_families(out_dir: str | Path, params: Params | None = None, speeds=Non
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     result = {}
-    for name, values in FAMILIES.items():
-        fam = family_data(params, name, values, speeds)
+    for name in FAMILIES:
+        fam = family_data(params, name, None, speeds)
         stem = "family_" + name.replace(".", "_")
         (out / f"{stem}.json").write_text(json.dumps({str(k): v for k, v in fam.items()}, indent=1))
         plot_family(fam, name, out / f"{stem}.png")

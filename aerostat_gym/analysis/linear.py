@@ -141,15 +141,47 @@ def central_jacobian(f, x: np.ndarray, cols: np.ndarray, steps: np.ndarray) -> n
     return J
 
 
+#: Difference schemes of :func:`input_jacobian`: +1 forward, 0 central, -1 backward.
+FORWARD, CENTRAL, BACKWARD = 1, 0, -1
+
+
+def speed_difference_side(params: Params, length: float, h: float) -> int:
+    """Which one-sided difference the reel-speed set-point needs at tether length ``length``.
+
+    Notes
+    -----
+    The compiled winch caps the set-point near the length limits by the stopping profile
+    v_cap(d) = min(d / (4 tau), sqrt(a_max d)), d the distance to the limit. A set-point step h
+    crosses the cap when v_cap(d) < h, i.e. within d < max(4 tau h, h^2 / a_max) of a limit;
+    there a central difference straddles the clip and halves B[v_w] (exactly at the limit the
+    outward step is clipped to 0). The inward one-sided difference keeps B[v_w] = 1 / tau:
+    backward (reel-in) near the upper limit, forward (reel-out) near the lower one.
+    """
+    w = params.winch
+    reach = 2.0 * max(4.0 * w.speed_time_constant * h, h * h / w.max_acceleration)
+    if w.max_length - length <= reach:
+        return BACKWARD
+    if length - w.min_length <= reach:
+        return FORWARD
+    return CENTRAL
+
+
 def input_jacobian(model: Model, x: np.ndarray, u_eq: np.ndarray, actuators, eps: float) -> np.ndarray:
-    """Input matrix B = d f / d u at (x, u_eq), one column per actuator (central differences)."""
+    """Input matrix B = d f / d u at (x, u_eq), one column per actuator.
+
+    Central differences, except for the reel-speed set-point near the winch's length limits,
+    where the inward one-sided difference avoids the set-point cap
+    (:func:`speed_difference_side`).
+    """
     B = np.empty((x.size, len(actuators)))
+    length = float(x[model.layout.winch_length])
     for k, a in enumerate(actuators):
         h = eps * a.scale
+        side = speed_difference_side(model.params, length, h) if a.index == U_SPEED else CENTRAL
         up, um = u_eq.copy(), u_eq.copy()
-        up[a.index] += h
-        um[a.index] -= h
-        B[:, k] = (model.rhs(x, up) - model.rhs(x, um)) / (2.0 * h)
+        up[a.index] += h * (side != BACKWARD)
+        um[a.index] -= h * (side != FORWARD)
+        B[:, k] = (model.rhs(x, up) - model.rhs(x, um)) / (up[a.index] - um[a.index])
     return B
 
 

@@ -330,63 +330,6 @@ def mac(a: np.ndarray, b: np.ndarray) -> float:
     return float(abs(np.vdot(a, b)) ** 2 / (np.vdot(a, a).real * np.vdot(b, b).real))
 
 
-def track(tables: list[list[Mode]], ctx_list: list[ModeContext], freq_weight: float = 0.5,
-          min_mac: float = 0.2) -> list[list[Mode | None]]:
-    """Follow modes across a sweep by eigenvector similarity.
-
-    Parameters
-    ----------
-    tables : list of list of Mode
-        Modal table at each sweep point.
-    ctx_list : list of ModeContext
-        The matching contexts.
-    freq_weight : float
-        Weight of the frequency jump in the matching cost.
-    min_mac : float
-        A match needs at least this MAC; otherwise the mode starts a new track.
-
-    Returns
-    -------
-    tracks : each a list with one :class:`Mode` (or None) per sweep point.
-
-    Notes
-    -----
-    Each step solves an assignment problem (Hungarian method) between the last mode of every
-    track and the current modes with cost 1 - MAC(phi_a, phi_b) + w |ln(omega_a / omega_b)|,
-    MAC taken on the energy-weighted position vectors sqrt(m) v.
-    """
-    tracks: list[list[Mode | None]] = [[m] for m in tables[0]]
-    vecs = [energy_vector(m.vector, ctx_list[0]) for m in tables[0]]
-    for step in range(1, len(tables)):
-        cur = tables[step]
-        cv = [energy_vector(m.vector, ctx_list[step]) for m in cur]
-        last = [next(m for m in reversed(t) if m is not None) for t in tracks]
-        cost = np.array([[1.0 - mac(vecs[i], cv[j])
-                          + freq_weight * abs(math.log(max(cur[j].wn, 1e-9) / max(last[i].wn, 1e-9)))
-                          for j in range(len(cur))] for i in range(len(tracks))])
-        rows, cols = linear_sum_assignment(cost)
-        taken = set()
-        for i, j in zip(rows, cols, strict=True):
-            if mac(vecs[i], cv[j]) >= min_mac:
-                tracks[i].append(cur[j])
-                vecs[i] = cv[j]
-                taken.add(j)
-        for t in tracks:
-            if len(t) < step + 1:
-                t.append(None)
-        for j, m in enumerate(cur):
-            if j not in taken:
-                tracks.append([None] * step + [m])
-                vecs.append(cv[j])
-    return tracks
-
-
-def track_label(track_modes: list[Mode | None]) -> str:
-    """The most frequent classification along a track (ties: the earliest)."""
-    labels = [m.label for m in track_modes if m is not None]
-    return max(dict.fromkeys(labels), key=labels.count)
-
-
 # --- sweeps --------------------------------------------------------------------------------------
 
 
@@ -431,20 +374,57 @@ class Sweep:
         return out
 
 
-def _label_tracks(tracks: list[list[Mode | None]]) -> list[tuple[str, list]]:
-    """Label every track; a repeated label gets a suffix (2), (3) in order of frequency."""
+def _lanes_of_label(tables: list[list[Mode]], ctx_list: list[ModeContext], label: str,
+                    freq_weight: float = 0.5) -> list[list[Mode | None]]:
+    """The modes classified ``label`` at each sweep point, in lanes (one per mode when several
+    share the label), continued from point to point by MAC and frequency (Hungarian method,
+    cost 1 - MAC + w |ln(omega_a / omega_b)| on the energy-weighted position vectors)."""
+    lanes: list[list[Mode | None]] = []
+    vecs: list[np.ndarray] = []
+    for step, (table, ctx) in enumerate(zip(tables, ctx_list, strict=True)):
+        cur = sorted((m for m in table if m.label == label), key=lambda m: m.wn)
+        cv = [energy_vector(m.vector, ctx) for m in cur]
+        assigned = {}
+        if lanes and cur:
+            last = [next(m for m in reversed(lane) if m is not None) for lane in lanes]
+            cost = np.array([[1.0 - mac(vecs[i], cv[j]) + freq_weight * abs(
+                math.log(max(cur[j].wn, 1e-9) / max(last[i].wn, 1e-9)))
+                for j in range(len(cur))] for i in range(len(lanes))])
+            rows, cols = linear_sum_assignment(cost)
+            assigned = {int(j): int(i) for i, j in zip(rows, cols, strict=True)}
+        for lane in lanes:
+            lane.append(None)
+        for j, m in enumerate(cur):
+            if j in assigned:
+                lanes[assigned[j]][step] = m
+                vecs[assigned[j]] = cv[j]
+            else:
+                lanes.append([None] * step + [m])
+                vecs.append(cv[j])
+    return lanes
+
+
+def label_tracks(tables: list[list[Mode]], ctx_list: list[ModeContext]
+                 ) -> list[tuple[str, list]]:
+    """Tracks of a sweep, labelled by eigenvector shape at every point.
+
+    Notes
+    -----
+    Each point's modes are classified on their own (:func:`classify` and
+    :func:`resolve_duplicates`, exactly as a single-speed analysis labels them), so the label of
+    a mode at a speed never depends on the other speeds of the grid. A track is the sequence of
+    the modes carrying one label; where several modes share a label at a point, MAC continuity
+    sorts them into lanes, the most present keeping the plain label and the others getting
+    (2), (3). Tracks are returned in order of mean natural frequency.
+    """
     def mean_wn(t):
         return float(np.mean([m.wn for m in t if m is not None]))
 
-    def present(t):
-        return sum(m is not None for m in t)
-
-    out, seen = [], {}
-    # the longest track keeps the plain label; shorter namesakes get (2), (3)
-    for t in sorted(tracks, key=lambda t: (-present(t), mean_wn(t))):
-        lab = track_label(t)
-        seen[lab] = seen.get(lab, 0) + 1
-        out.append((lab if seen[lab] == 1 else f"{lab} ({seen[lab]})", t))
+    out = []
+    for label in dict.fromkeys(m.label for table in tables for m in table):
+        lanes = _lanes_of_label(tables, ctx_list, label)
+        lanes.sort(key=lambda t: (-sum(m is not None for m in t), mean_wn(t)))
+        out += [(label if k == 0 else f"{label} ({k + 1})", lane) for k, lane in enumerate(lanes)]
     return sorted(out, key=lambda item: mean_wn(item[1]))
 
 
@@ -455,7 +435,7 @@ def sweep_analyses(analyses: list[ModalAnalysis], params_list: list[Params], val
     for subset in SETS:
         ctxs = [mode_context(p, a.linear.x_eq, subset) for p, a in zip(params_list, analyses, strict=True)]
         tables = [getattr(a, subset) for a in analyses]
-        tracks[subset] = _label_tracks(track(tables, ctxs))
+        tracks[subset] = label_tracks(tables, ctxs)
     return Sweep(np.asarray(values, float), variable, analyses, tracks, seconds)
 
 

@@ -1,8 +1,9 @@
 """Sensitivity of the linear results to the estimated and calibrated parameters.
 
 Most aerostat parameters of the baseline are ESTIMATE or CALIB (``parameter_table()``); this
-module moves each across its stated plausible range (docs/parameters.md; the range and its
-source are in :data:`KNOBS`) and reports how the four [LN02] Table 2 periods at U = 1 m/s and
+module moves each across a plausible range relative to the configured value (the baseline's
+documented range in docs/parameters.md as factors of its value, positions in hull lengths;
+:func:`default_knobs`) and reports how the four [LN02] Table 2 periods at U = 1 m/s and
 the smallest damping ratio of the Figure 9 modes over 1..20 m/s respond. It tells a user which
 of their own aerostat's numbers matter, and :func:`solve_for_period` says how far one knob must
 move to put a period on a target (for a documented calibration, never applied silently).
@@ -103,48 +104,85 @@ def _pm(base: float, frac: float) -> tuple[float, float]:
     return base * (1 - frac), base * (1 + frac)
 
 
+def _rel(base: float, low: float, high: float) -> tuple[float, float]:
+    """(low base, high base): a range as factors of the configured value."""
+    return base * low, base * high
+
+
+#: Half-width of the CM and CB position ranges in hull lengths: the baseline's +-0.3 m on its
+#: 18.3 m hull (component mass model, docs/parameters.md section 1e).
+POSITION_SPREAD_HULL_LENGTHS = 0.3 / 18.3
+
+
 def default_knobs(params: Params | None = None) -> list[Knob]:
-    """The uncertain parameters and their ranges (docs/parameters.md sections 1-5)."""
+    """The uncertain parameters and their ranges, relative to the configured values.
+
+    Every range is a factor of the configured value (or, for positions, a multiple of the
+    configured hull length), so it follows the user's aerostat. The factors are the baseline's
+    plausible ranges (docs/parameters.md sections 1-5) divided by the baseline's value; for the
+    shipped baseline the ranges are therefore the documented absolute ones (e.g. fin area
+    12-25 m^2, CM shift +-0.3 m).
+    """
     p = params or load_params()
-    a = p.aerostat
+    a, h, f, t = p.aerostat, p.hull, p.fins, p.tether
+    spread = POSITION_SPREAD_HULL_LENGTHS * a.length
     ks = []
 
-    def add(key, label, status, unit, lo, hi, source, getput):
-        ks.append(Knob(key, label, status, unit, float(lo), float(hi), source, *getput))
+    def add(key, label, status, unit, lo_hi, source, getput):
+        ks.append(Knob(key, label, status, unit, float(lo_hi[0]), float(lo_hi[1]), source, *getput))
 
-    add("hull.eta_k", "hull efficiency eta_k", "CALIB", "-", 0.1, 0.5,
-        ">= 0.5 yaw-divergent (sec. 5); with C_L_alpha 1.79 the 67.4 s pendulum wanted 0.1-0.25",
-        _dotted("hull.eta_k"))
-    add("fins.CL_alpha", "fin lift slope C_L_alpha", "CALIB", "1/rad", 1.2, 2.5,
-        "plausible range (sec. 1d); 1.43 calibrated to the 67.4 s lateral pendulum", _dotted("fins.CL_alpha"))
-    add("fins.planform_area", "fin planform area A_f", "ESTIMATE", "m^2", 12.0, 25.0,
-        "plausible range (sec. 1d)", _dotted("fins.planform_area"))
-    add("cm_x_shift", "CM moved forward", "CALIB", "m", -0.3, 0.3,
-        "component mass model: CM moves 0.1-0.3 m (sec. 1e)", _cm_knob())
+    add("hull.eta_k", "hull efficiency eta_k", "CALIB", "-", _rel(h.eta_k, 0.25, 1.25),
+        "x0.25-1.25 (baseline 0.1-0.5: >= 0.5 yaw-divergent, sec. 5)", _dotted("hull.eta_k"))
+    add("fins.CL_alpha", "fin lift slope C_L_alpha", "CALIB", "1/rad",
+        _rel(f.CL_alpha, 1.2 / 1.43, 2.5 / 1.43),
+        "x0.84-1.75 (baseline 1.2-2.5 about 1.43, sec. 1d)", _dotted("fins.CL_alpha"))
+    add("fins.planform_area", "fin planform area A_f", "ESTIMATE", "m^2",
+        _rel(f.planform_area, 12.0 / 18.0, 25.0 / 18.0),
+        "x0.67-1.39 (baseline 12-25 m^2 about 18, sec. 1d)", _dotted("fins.planform_area"))
+    add("cm_x_shift", "CM moved forward", "CALIB", "m", (-spread, spread),
+        "+-0.0164 hull lengths (baseline +-0.3 m, sec. 1e)", _cm_knob())
     xb, _, zb = a.cb_position
-    add("aerostat.cb_position[x]", "CB x relative to CM", "CALIB", "m", xb - 0.3, xb + 0.3,
-        "+-0.3 m, as the CM (sec. 1e); x_l moves 2.2x as much", _vector_component("aerostat.cb_position", 0))
-    add("aerostat.cb_position[z]", "CB z relative to CM", "CALIB", "m", zb - 0.3, zb + 0.3,
-        "+-0.3 m (sec. 1e)", _vector_component("aerostat.cb_position", 2))
+    add("aerostat.cb_position[x]", "CB x relative to CM", "CALIB", "m", (xb - spread, xb + spread),
+        "+-0.0164 hull lengths, as the CM (sec. 1e); x_l moves 2.2x as much",
+        _vector_component("aerostat.cb_position", 0))
+    add("aerostat.cb_position[z]", "CB z relative to CM", "CALIB", "m", (zb - spread, zb + spread),
+        "+-0.0164 hull lengths (sec. 1e)", _vector_component("aerostat.cb_position", 2))
     for name in ("Ixx", "Iyy", "Izz"):
-        base = getattr(a, name)
-        add(f"aerostat.{name}", f"inertia {name}", "ESTIMATE", "kg m^2", *_pm(base, 0.3),
+        add(f"aerostat.{name}", f"inertia {name}", "ESTIMATE", "kg m^2", _pm(getattr(a, name), 0.3),
             "+-30 % (sec. 1a)", _dotted(f"aerostat.{name}"))
-    add("aerostat.Ixz", "product of inertia Ixz", "ESTIMATE", "kg m^2", -abs(a.Ixz), abs(a.Ixz),
+    add("aerostat.Ixz", "product of inertia Ixz", "ESTIMATE", "kg m^2", (-abs(a.Ixz), abs(a.Ixz)),
         "sign uncertain (sec. 1a)", _dotted("aerostat.Ixz"))
-    add("hull.Cdc", "hull cross-flow drag (C_dc)_h", "ESTIMATE", "-", 0.3, 1.2,
-        "0.3-0.6 supercritical, 1.2 subcritical cylinder (sec. 1c)", _dotted("hull.Cdc"))
-    add("aerostat.k1", "axial added-mass coeff. k1", "ESTIMATE", "-", 0.086, 0.188,
-        "Table 2 fits for rho 1.225-1.120 (sec. 2)", _dotted("aerostat.k1"))
-    add("aerostat.k3", "lateral added-mass coeff. k3", "ESTIMATE", "-", 0.584, 0.803,
-        "Table 2 fits for rho 1.225-1.120 (sec. 2)", _dotted("aerostat.k3"))
-    add("environment.rho_air", "air density (net lift kept)", "DERIVED", "kg/m^3", 1.120, 1.225,
-        "Table 2 fit range, ISA sea level (sec. 2); mass adjusted", _rho_keep_lift())
-    add("hull.CD0", "hull axial drag (C_D,h)0", "ESTIMATE", "-", 0.025, 0.04,
-        "range (sec. 1c)", _dotted("hull.CD0"))
-    add("tether.Cd_normal", "tether normal drag C_dn", "ESTIMATE", "-", 1.0, 1.5,
-        "braided rope (sec. 1f)", _dotted("tether.Cd_normal"))
+    add("hull.Cdc", "hull cross-flow drag (C_dc)_h", "ESTIMATE", "-", _rel(h.Cdc, 0.25, 1.0),
+        "x0.25-1 (baseline 0.3-1.2: supercritical to subcritical cylinder, sec. 1c)",
+        _dotted("hull.Cdc"))
+    add("aerostat.k1", "axial added-mass coeff. k1", "ESTIMATE", "-",
+        _rel(a.k1, 0.086 / 0.1672, 0.188 / 0.1672),
+        "x0.51-1.12 (baseline Table 2 fits 0.086-0.188, sec. 2)", _dotted("aerostat.k1"))
+    add("aerostat.k3", "lateral added-mass coeff. k3", "ESTIMATE", "-",
+        _rel(a.k3, 0.584 / 0.7494, 0.803 / 0.7494),
+        "x0.78-1.07 (baseline Table 2 fits 0.584-0.803, sec. 2)", _dotted("aerostat.k3"))
+    add("environment.rho_air", "air density (net lift kept)", "DERIVED", "kg/m^3",
+        _rel(p.environment.rho_air, 1.120 / 1.147, 1.225 / 1.147),
+        "x0.976-1.068 (baseline 1.120-1.225, sec. 2); mass adjusted", _rho_keep_lift())
+    add("hull.CD0", "hull axial drag (C_D,h)0", "ESTIMATE", "-",
+        _rel(h.CD0, 0.025 / 0.029, 0.04 / 0.029), "x0.86-1.38 (baseline 0.025-0.04, sec. 1c)",
+        _dotted("hull.CD0"))
+    add("tether.Cd_normal", "tether normal drag C_dn", "ESTIMATE", "-",
+        _rel(t.Cd_normal, 1.0 / 1.2, 1.5 / 1.2), "x0.83-1.25 (baseline 1.0-1.5, sec. 1f)",
+        _dotted("tether.Cd_normal"))
     return ks
+
+
+def select_knobs(knobs: list[Knob], keys) -> list[Knob]:
+    """The knobs named in ``keys`` (all if ``keys`` is empty); an unknown key is an error naming
+    the known ones."""
+    if not keys:
+        return knobs
+    known = {k.key: k for k in knobs}
+    unknown = [k for k in keys if k not in known]
+    if unknown:
+        raise ValueError(f"unknown sensitivity knob(s) {unknown}; known: {list(known)}")
+    return [known[k] for k in keys]
 
 
 # --- evaluation ----------------------------------------------------------------------------------

@@ -28,7 +28,6 @@ import scipy.sparse.linalg
 
 from ..params import Params, load_params
 from ..physics.core import rotation_matrix
-from ..physics.wind import pack_wind
 from ..sim import Model
 
 REL_TOL = 1e-9
@@ -210,7 +209,7 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
     u = u0
     while True:
         target = min(u + step, wind_speed) if wind_speed >= u else max(u - step, wind_speed)
-        _set_speed(model, params, target)
+        model.set_wind(target)
         xn, rel, it = _newton(model, x.copy(), tol, 40)
         its += it
         if rel <= tol:
@@ -223,19 +222,13 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
             if step < max_step / 64:
                 raise TrimError(f"no equilibrium found at U = {target:.3f} m/s (continuing from "
                                 f"{u:.3f} m/s): relative residual {rel:.2e} > {tol:.0e}")
-    _set_speed(model, params, wind_speed)
+    model.set_wind(wind_speed)
     summary = trim_summary(model, x, wind_speed)
     if summary["min_tension_N"] <= 0 or x[model.layout.cm_pos][2] <= 0:
         raise TrimError(f"the solution at U = {wind_speed} m/s is not a flying equilibrium "
                         f"(min tension {summary['min_tension_N']:.1f} N, height {x[model.layout.cm_pos][2]:.1f} m)")
     return Equilibrium(x=x, wind_speed=float(wind_speed), params=params, residual=float(rel),
                        iterations=its, summary=summary)
-
-
-def _set_speed(model: Model, params: Params, speed: float) -> None:
-    w = params.wind
-    model.wp = pack_wind(w.profile, speed, w.direction_deg, w.reference_height,
-                         w.shear_exponent, w.roughness_length)
 
 
 def trim_summary(model: Model, x: np.ndarray, wind_speed: float) -> dict:

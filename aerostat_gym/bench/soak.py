@@ -68,7 +68,7 @@ def soak_configuration(cfg: dict, steps: int, num_envs: int, seed: int, counts: 
     try:
         obs, _ = env.reset(seed=seed)
         _check_obs(obs, low, high, counts)
-        for _ in range(max(1, steps // num_envs)):
+        for _ in range(max(1, -(-steps // num_envs))):  # rounded up: at least `steps`
             actions = rng.uniform(-1.5, 1.5, (num_envs, 1)).astype(np.float32)
             obs, rew, term, trunc, info = env.step(actions)
             counts["steps"] += num_envs
@@ -122,7 +122,7 @@ def run_soak(total_steps: int = 1_000_000, num_envs: int = 8, seed: int = 0,
         ``seconds``.
     """
     configs = configurations() if configs is None else configs
-    share = max(num_envs, total_steps // len(configs))
+    share = max(num_envs, -(-total_steps // len(configs)))  # rounded up
     counts: Counter = Counter(steps=0, exceptions=0, nonfinite_obs=0, nonfinite_reward=0,
                               obs_outside_space=0)
     errors = []

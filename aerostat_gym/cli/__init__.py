@@ -3,7 +3,8 @@
 Commands: ``trim`` (equilibrium summary), ``params`` (every parameter with its unit and status),
 ``bench`` (speed and accuracy figures), ``wind`` (turbulence statistics), ``stability``,
 ``table2`` and ``sensitivity`` (linear stability analysis), ``train``, ``evaluate`` and ``demo``
-(winch-control agents). Errors in user input print one clear line and exit with status 2.
+(winch-control agents), ``tune`` and ``montecarlo`` (Ray, the optional extra). Errors in user
+input print one clear line and exit with status 2.
 
 One module per group of commands (``model``, ``wind``, ``stability``, ``agents``), each with an
 ``add_*_parsers`` function; ``common`` holds the options they share.
@@ -18,17 +19,33 @@ from ..params import ParameterError
 from .agents import add_agent_parsers
 from .common import OneLineParser
 from .model import add_model_parsers
+from .scale import add_montecarlo_parser, add_tune_parser
 from .stability import add_stability_parsers
 from .wind import add_wind_parser
 
+DESCRIPTION = ("Tethered-aerostat simulator (Lambert & Nahon 2002), linear stability analysis and "
+               "winch-control agents. Run 'aerostat-gym COMMAND --help' for a command's options.")
+
+
+class Parser(OneLineParser):
+    """Every command's parser shows each option's default in its help, and reports a bad
+    option as one line on stderr with exit status 2."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", argparse.ArgumentDefaultsHelpFormatter)
+        super().__init__(*args, **kwargs)
+
 
 def build_parser() -> argparse.ArgumentParser:
-    ap = OneLineParser(prog="aerostat-gym", description=__doc__.split("\n")[0])
-    sub = ap.add_subparsers(dest="command", required=True)
+    ap = Parser(prog="aerostat-gym", description=DESCRIPTION)
+    sub = ap.add_subparsers(dest="command", required=True, parser_class=Parser,
+                            metavar="COMMAND")
     add_model_parsers(sub)
     add_wind_parser(sub)
     add_stability_parsers(sub)
     add_agent_parsers(sub)
+    add_tune_parser(sub)
+    add_montecarlo_parser(sub)
     return ap
 
 

@@ -11,7 +11,7 @@ import math
 import sys
 from pathlib import Path
 
-from ..params import ParameterError, load_params, tomllib
+from ..params import ParameterError, load_params, shipped_configs, tomllib
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -71,13 +71,30 @@ def existing_file(text: str) -> str:
     return text
 
 
-def add_config(p: argparse.ArgumentParser) -> None:
-    """``--config``, ``--set`` and ``--json`` on a command's parser."""
-    p.add_argument("--config", type=existing_file,
-                   help="parameter TOML file (default: the shipped baseline)")
+def config_source(text: str) -> str:
+    """argparse type of ``--config``: a shipped configuration's name or an existing file."""
+    if text in shipped_configs() or Path(text).is_file():
+        return text
+    raise argparse.ArgumentTypeError(f"neither a shipped configuration "
+                                     f"({', '.join(shipped_configs())}) nor a file: {text!r}")
+
+
+def add_config(p: argparse.ArgumentParser, json: bool = True) -> None:
+    """``--config``, ``--set`` and (unless ``json=False``) ``--json`` on a command's parser."""
+    p.add_argument("--config", type=config_source,
+                   help="parameter TOML file or a shipped configuration's name "
+                   f"({', '.join(shipped_configs())}; default: the baseline)")
     p.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override one parameter, e.g. --set tether.length=150 (repeatable)")
-    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    if json:
+        p.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+
+def config_label(args) -> str:
+    """How the configuration was given, for headers: the file or name, plus the overrides."""
+    label = getattr(args, "config", None) or "baseline"
+    sets = getattr(args, "set", None) or []
+    return label + "".join(f" --set {s}" for s in sets)
 
 
 def parse_overrides(items: list[str]) -> dict:

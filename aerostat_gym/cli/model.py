@@ -7,6 +7,7 @@ import json
 
 from ..analysis.trim import find_equilibrium, limit_warnings
 from ..bench import format_text, run_bench
+from ..bench.moordyn_dynamic import format_report, run_dynamic_comparison
 from ..params import parameter_table
 from .common import add_config, nonneg_float, params_from_args, warn
 
@@ -42,6 +43,10 @@ def cmd_params(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    if args.moordyn_dynamic:  # the tether in motion against MoorDyn (bench extra)
+        res = run_dynamic_comparison(quick=args.quick)
+        print(json.dumps(res, indent=2, default=float) if args.json else format_report(res))
+        return 0
     res = run_bench(quick=args.quick)
     print(json.dumps(res, indent=2) if args.json else format_text(res))
     return 0
@@ -60,4 +65,6 @@ def add_model_parsers(sub) -> None:
     p = sub.add_parser("bench", help="speed and accuracy figures")
     p.add_argument("--json", action="store_true")
     p.add_argument("--quick", action="store_true", help="shorter runs (smoke test)")
+    p.add_argument("--moordyn-dynamic", action="store_true",
+                   help="only the dynamic comparison with MoorDyn (driven top end)")
     p.set_defaults(func=cmd_bench)

@@ -6,8 +6,10 @@
   [--json] [--plot DIR]``: trim, linearize and analyse at every wind speed; print the Figure 9
   modes (period and damping ratio), stability and the coupling ratios; ``--plot`` writes the
   Figure 9 PNG, CSV and JSON into DIR.
-* ``table2 [--config FILE] [--json]``: [LN02] Table 2 with this model.
-* ``sensitivity [--config FILE] [--json]``: how the estimated parameters move the Table 2
+* ``table2 [--config FILE] [--json]``: Table 2 for the configured aerostat, its linear model
+  against its own closed forms (the paper's columns only for the paper's case).
+* ``sensitivity [--config FILE] [--wind A:B:S] [--knob KEY] [--json]``: how the estimated
+  parameters, each moved across a range relative to its configured value, move the Table 2
   periods and the smallest damping ratio.
 
 Each handler returns an exit status; invalid input raises ValueError (the main CLI prints it
@@ -24,7 +26,13 @@ import numpy as np
 from ..analysis.figures import figure9_data, write_figure9
 from ..analysis.modes import FIGURE9_MODES, SETS, wind_sweep
 from ..analysis.reference import format_table2, table2
-from ..analysis.sensitivity import format_sensitivity, sensitivity_table
+from ..analysis.sensitivity import (
+    DAMPING_SPEEDS,
+    default_knobs,
+    format_sensitivity,
+    select_knobs,
+    sensitivity_table,
+)
 from ..analysis.trim import find_equilibrium, limit_warnings
 from .common import add_config, params_from_args, positive_float, positive_int, warn
 
@@ -52,7 +60,7 @@ def parse_speeds(text: str) -> np.ndarray:
     return speeds
 
 
-def _params(args):
+def stability_params(args):
     return params_from_args(args, **{"tether.length": getattr(args, "length", None),
                                      "tether.n_elements": getattr(args, "elements", None)})
 
@@ -88,7 +96,7 @@ def _stability_text(sweep, dec_ratios: list[dict]) -> str:
 
 
 def cmd_stability(args) -> int:
-    params = _params(args)
+    params = stability_params(args)
     speeds = parse_speeds(args.wind)
     # the tension grows with the wind: the top speed's trim tells what the winch and tether
     # cannot hold (TrimLimitError past the tether strength)
@@ -120,13 +128,18 @@ def _json_default(v):
 
 
 def cmd_table2(args) -> int:
-    rows = table2(_params(args))
+    rows = table2(stability_params(args))
     print(json.dumps(rows, indent=1) if args.json else format_table2(rows))
     return 0
 
 
 def cmd_sensitivity(args) -> int:
-    table = sensitivity_table(_params(args))
+    params = stability_params(args)
+    speeds = parse_speeds(args.wind) if args.wind else DAMPING_SPEEDS
+    if np.any(np.asarray(speeds) <= 0):
+        raise ValueError("sensitivity --wind speeds must be > 0 (at 0 m/s every mode is undamped)")
+    knobs = select_knobs(default_knobs(params), args.knob)
+    table = sensitivity_table(params, knobs, tuple(float(u) for u in speeds))
     print(json.dumps(table, indent=1, default=_json_default) if args.json else format_sensitivity(table))
     return 0
 
@@ -145,6 +158,11 @@ def add_stability_parsers(subparsers) -> None:
     p = subparsers.add_parser("table2", help="[LN02] Table 2: reference vs linear-model periods")
     add_config(p)
     p.set_defaults(func=cmd_table2)
-    p = subparsers.add_parser("sensitivity", help="Table 2 periods and damping vs uncertain parameters")
+    p = subparsers.add_parser("sensitivity", help="Table 2 periods and damping vs uncertain parameters "
+                              "(ranges relative to the configured values)")
+    p.add_argument("--wind", default=None, help="START:STOP[:STEP] speeds of the damping search "
+                   "[m/s] (default 1, 2, 4, ..., 20)")
+    p.add_argument("--knob", action="append", default=[],
+                   help="only this knob, e.g. fins.planform_area (repeatable; default all)")
     add_config(p)
     p.set_defaults(func=cmd_sensitivity)

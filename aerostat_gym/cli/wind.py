@@ -13,9 +13,12 @@ import time
 
 import numpy as np
 
+from ..analysis.intensity import air_inertia_force
+from ..params import load_params
 from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
-from ..wind.field import build_wind, field_heights, field_times
-from ..wind.presets import METHODS, PRESETS, get_preset
+from ..wind.field import build_wind, field_heights, field_times, mean_vector
+from ..wind.presets import INTENSITY_MODELS, METHODS, PRESETS
+from ..wind.sizing import FROM_CONFIG, sized_turbulence
 from ..wind.spectra import MODELS
 from ..wind.stats import (
     COMPONENTS,
@@ -27,7 +30,7 @@ from ..wind.stats import (
     target_psd,
     welch_psd,
 )
-from .common import nonneg_float, positive_float, positive_int
+from .common import add_config, nonneg_float, params_from_args, positive_float, positive_int
 
 
 def add_wind_parser(subparsers) -> argparse.ArgumentParser:
@@ -37,31 +40,40 @@ def add_wind_parser(subparsers) -> argparse.ArgumentParser:
         description="Generate the turbulence field of one episode and print its realised "
         "statistics (sigma, integral length scale, coherence between heights) next to their "
         "targets. One 600 s record gives rough values; pool seeds with --ensemble.")
-    p.add_argument("--preset", default="moderate", choices=list(PRESETS))
+    p.add_argument("--preset", default=None, choices=[*PRESETS, FROM_CONFIG],
+                   help=f"one of {list(PRESETS)} or '{FROM_CONFIG}' "
+                   "(the parameter file's wind.turbulence; default: moderate, or the file's "
+                   "preset with --config)")
     p.add_argument("--seed", type=int, default=0, help="seed of numpy.random.default_rng")
     p.add_argument("--duration", type=positive_float, default=600.0, help="episode length [s]")
     p.add_argument("--speed", type=nonneg_float, default=8.0,
                    help="mean speed at the reference height [m/s]")
-    p.add_argument("--profile", default="uniform", choices=sorted(PROFILES), help="mean profile")
-    p.add_argument("--reference-height", type=positive_float, default=10.0,
-                   help="reference height of the power/log profile [m]")
+    p.add_argument("--profile", default=None, choices=sorted(PROFILES),
+                   help="mean profile (default: the configuration's wind.profile)")
+    p.add_argument("--reference-height", type=positive_float, default=None,
+                   help="reference height of the power/log profile [m] (default: the configuration's)")
+    p.add_argument("--intensity-model", choices=INTENSITY_MODELS,
+                   help="how sigma follows the mean wind (default: the preset's, 'mil')")
     p.add_argument("--model", choices=MODELS, help="override the preset's spectrum")
     p.add_argument("--method", choices=METHODS, help="override the generation method")
-    p.add_argument("--height", type=positive_float,
-                   help="aerostat nominal height (field advection) [m]")
+    p.add_argument("--height", type=positive_float, help="aerostat nominal height (field advection) [m] "
+                   "(default: the configuration's wind.turbulence_reference_height)")
     p.add_argument("--ensemble", type=positive_int, default=1,
                    help="pool this many seeds from --seed on")
     p.add_argument("--plot", metavar="FILE", help="write a PNG (time series, PSD, coherence)")
-    p.add_argument("--json", action="store_true", help="print the statistics as JSON")
+    add_config(p)
     p.set_defaults(func=wind_command)
     return p
 
 
-def _config(args):
-    """Preset with the command-line overrides (errors are ValueError with a clear message)."""
-    cfg = get_preset(args.preset)
+def _config(args, params):
+    """Preset with the command-line overrides, its field grid sized from the configuration
+    (errors are ValueError with a clear message)."""
+    preset = args.preset or (FROM_CONFIG if args.config else "moderate")
+    cfg = sized_turbulence(params, preset)
     changes = {k: v for k, v in (("model", args.model), ("method", args.method),
-                                 ("reference_height", args.height)) if v is not None}
+                                 ("reference_height", args.height),
+                                 ("intensity_model", args.intensity_model)) if v is not None}
     if changes.get("method") == "filter" and "model" not in changes:
         changes["model"] = "dryden"
     return cfg.replace(**changes) if changes else cfg
@@ -70,11 +82,14 @@ def _config(args):
 def wind_command(args) -> int:
     """Run ``aerostat-gym wind``; returns the exit status (2 on invalid input)."""
     try:
-        cfg = _config(args)
+        params = params_from_args(args)
+        cfg = _config(args, params)
         if args.ensemble < 1:
             raise ValueError(f"--ensemble must be >= 1, got {args.ensemble}")
-        mean = {"profile": args.profile, "speed": args.speed,
-                "reference_height": args.reference_height}
+        w = params.wind
+        mean = {"profile": args.profile or w.profile, "speed": args.speed,
+                "reference_height": args.reference_height or w.reference_height,
+                "shear_exponent": w.shear_exponent, "roughness_length": w.roughness_length}
         build_wind(mean, cfg, 1.0, np.random.default_rng(0))  # load the compiled kernels
         t0 = time.perf_counter()
         wp, wf = build_wind(mean, cfg, args.duration, np.random.default_rng(args.seed))
@@ -84,15 +99,26 @@ def wind_command(args) -> int:
     except (ValueError, TypeError) as e:
         print(f"aerostat-gym wind: error: {e}", file=sys.stderr)
         return 2
-    out = {"preset": args.preset, "model": cfg.model, "method": cfg.method, "seed": args.seed,
-           "duration_s": args.duration, "mean_speed": args.speed,
+    out = {"preset": args.preset or (FROM_CONFIG if args.config else "moderate"),
+           "intensity_model": cfg.intensity_model, "model": cfg.model, "method": cfg.method,
+           "seed": args.seed, "duration_s": args.duration, "mean_speed": args.speed,
            "field_shape": list(wf.shape), "generation_s": gen_s}
+    cfg = cfg.for_wind(mean_vector(mean))  # the class's sigmas in this mean wind
     if not cfg.is_off:
         out.update(realised_statistics(cfg, wp, fields))
+        out["air_inertia"] = _air_inertia(cfg, wp, wf, args.duration)
     print(json.dumps(out, indent=2) if args.json else _table(out))
     if args.plot and not cfg.is_off:
         _plot(args.plot, cfg, wp, fields)
     return 0
+
+
+def _air_inertia(cfg, wp, wf, duration: float) -> dict:
+    """Air-inertia force on the baseline hull held at the field's reference height."""
+    p = load_params()
+    a = p.aerostat
+    return air_inertia_force(wp, wf, (0.0, 0.0, cfg.reference_height),
+                             p.environment.rho_air * a.volume, a.k1, a.k3, a.length, duration)
 
 
 def _table(out: dict) -> str:
@@ -109,6 +135,11 @@ def _table(out: dict) -> str:
         lines.append(f"{name:4}{c['sigma']:10.3f}{c['sigma_target']:10.3f}"
                      f"{c['integral_length']:12.1f}{c['integral_length_target']:10.1f}"
                      f"{c['integral_length_acf']:16.1f}")
+    ai = out["air_inertia"]
+    lines.append(f"air inertia on the baseline hull held at {out['height']:.0f} m ((1 + k_i) rho V "
+                 f"dW_i/dt): RMS axial {ai['rms_axial_n']:.0f} N, lateral {ai['rms_lateral_n']:.0f} N, "
+                 f"vertical {ai['rms_vertical_n']:.0f} N, peak |F| {ai['peak_n']:.0f} N "
+                 f"(RMS |dW/dt| {ai['rms_air_acceleration_m_s2']:.3f} m/s^2)")
     lines.append("coherence realised/target (IEC), band-averaged around f:")
     for name, c in out["components"].items():
         for r, d in c["coherence"].items():

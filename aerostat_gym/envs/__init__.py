@@ -11,7 +11,7 @@ from ..registration import ENV_ID, MAX_EPISODE_STEPS, register
 from .batch import ActionError, EnvBatch
 from .config import TaskConfig, TaskError
 from .env import TetheredAerostatEnv
-from .reward import DEFAULT_WEIGHTS, REWARD_TERMS
+from .reward import DEFAULT_WEIGHTS, REWARD_TERMS, reward_table
 from .sb3 import sb3_vec_env
 from .spaces import CHANNELS, OBS_INDEX, observation_table
 from .vector import TetheredAerostatVectorEnv
@@ -19,4 +19,4 @@ from .vector import TetheredAerostatVectorEnv
 __all__ = ["ActionError", "CHANNELS", "DEFAULT_WEIGHTS", "ENV_ID", "EnvBatch",
            "MAX_EPISODE_STEPS", "OBS_INDEX", "REWARD_TERMS", "TaskConfig", "TaskError",
            "TetheredAerostatEnv", "TetheredAerostatVectorEnv", "observation_table", "register",
-           "sb3_vec_env"]
+           "reward_table", "sb3_vec_env"]

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import warnings
 
+import numba
 import numpy as np
 
 from ..analysis.trim import TrimError
@@ -20,9 +21,22 @@ from ..sim.events import RUNNING
 from . import kernel as K
 from . import reward, spaces
 from .config import TaskConfig, TaskError
-from .episodes import TrimTable, field_length_needed, sample_episode, turbulence_bank
+from .episodes import TrimTable, field_length_needed, sample_episode, unit_bank
 
 NO_BANK = np.zeros((1, 1, 0, 3))
+
+
+def check_threads(threads: int | None) -> int:
+    """Threads of the batched step: an integer from 1 to numba's NUMBA_NUM_THREADS (default:
+    all of them); anything else is a ValueError naming the value."""
+    top = numba.config.NUMBA_NUM_THREADS
+    if threads is None:
+        return top
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) \
+            or not 1 <= threads <= top:
+        raise ValueError(f"threads must be an integer from 1 to {top} (NUMBA_NUM_THREADS), got "
+                         f"{threads!r}")
+    return int(threads)
 
 
 class ActionError(ValueError):
@@ -72,6 +86,8 @@ class EnvBatch:
         The validated environment arguments.
     num_envs : int
         Number of environments.
+    threads : int, optional
+        Threads of the batched step (default: NUMBA_NUM_THREADS).
 
     Notes
     -----
@@ -79,9 +95,10 @@ class EnvBatch:
     read modulo their length, so every episode length is served by the same bank.
     """
 
-    def __init__(self, task: TaskConfig, num_envs: int):
+    def __init__(self, task: TaskConfig, num_envs: int, threads: int | None = None):
         self.task = task
         self.num_envs = N = int(num_envs)
+        self.threads = check_threads(threads)
         params = task.params_resolved
         self.params = params
         self.layout = StateLayout(params.tether.n_elements)
@@ -121,7 +138,8 @@ class EnvBatch:
             return NO_BANK
         u_max = self.trims.speeds[-1] * _advection_factor(self.params, turb)
         need = field_length_needed(turb, u_max)
-        return turbulence_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
+        # unit-variance fields, scaled per episode to its mean wind (episodes._intensity)
+        return unit_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
 
     def release(self) -> None:
         """Drop this batch's reference to the turbulence bank (freed with its last user)."""
@@ -242,6 +260,8 @@ class EnvBatch:
             return
         if active is None:
             active = np.ones(self.num_envs, dtype=np.bool_)
+        if numba.get_num_threads() != self.threads:
+            numba.set_num_threads(self.threads)
         K.step_parallel(active, *self._arrays())
 
     def add_noise(self, i: int, rng: np.random.Generator) -> None:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..params import ParameterError, Params, apply_overrides, load_params
 from ..sim import INTEGRATORS
-from ..wind.presets import resolve_turbulence
+from ..wind.sizing import sized_turbulence
 from . import reward
 
 #: Perturbation presets: maximum along-wind swing and lateral displacement of the aerostat [m]
@@ -32,6 +32,10 @@ DEFAULT_RANDOMIZATION = {
     "aerostat.Ixx": 0.3, "aerostat.Iyy": 0.3, "aerostat.Izz": 0.3, "hull.Cdc": 0.2,
     "hull.eta_k": 0.2, "fins.CL_alpha": 0.2, "tether.Cd_normal": 0.2, "aerostat.mass": 0.03,
 }
+
+
+#: Default range of the episode's mean wind speed [m/s].
+DEFAULT_WIND_RANGE = (3.0, 15.0)
 
 
 class TaskError(ValueError):
@@ -58,7 +62,7 @@ def _positive(name, value):
 class TaskConfig:
     """Validated environment arguments (see :class:`aerostat_gym.envs.TetheredAerostatEnv`)."""
 
-    wind_speed: tuple = (3.0, 15.0)
+    wind_speed: tuple = DEFAULT_WIND_RANGE
     turbulence: object = "moderate"
     perturbation: object = "mixed"
     tether_length: float | None = None
@@ -79,10 +83,6 @@ class TaskConfig:
     def __post_init__(self):
         r = self.resolved
         r["wind_speed"] = _range("wind_speed", self.wind_speed)
-        try:
-            r["turbulence"] = resolve_turbulence(self.turbulence)
-        except (TypeError, ValueError) as exc:
-            raise TaskError(f"turbulence: {exc}") from None
         r["perturbation"] = perturbation(self.perturbation)
         if self.integrator not in INTEGRATORS:
             raise TaskError(f"unknown integrator {self.integrator!r}; choose one of {INTEGRATORS}")
@@ -103,6 +103,10 @@ class TaskConfig:
         if not (isinstance(self.wind_bank_size, int) and self.wind_bank_size >= 1):
             raise TaskError(f"wind_bank_size must be an integer >= 1, got {self.wind_bank_size!r}")
         r["params"] = self._params()
+        try:  # the field's heights and extent follow the configured aerostat, tether and winch
+            r["turbulence"] = sized_turbulence(r["params"], self.turbulence)
+        except (TypeError, ValueError) as exc:
+            raise TaskError(f"turbulence: {exc}") from None
         r["randomize"] = self._randomize(r["params"])
 
     def _params(self) -> Params:

@@ -103,9 +103,11 @@ class TetheredAerostatEnv(gym.Env):
     ``"mixed"``): aerostat and tether swung rigidly about the winch by up to 10 m along the
     wind and 5 m across it (no element stretched), the aerostat pitched about its confluence
     point by up to 0.05 rad, and with probability 0.5 a 1 - cos gust along the wind (1-4 m/s,
-    5-20 s, onset within 30 s). Turbulence (default ``"moderate"``, sigma_u = 1.6 m/s von
-    Karman) is a frozen coherent field from a bank generated once per process from
-    ``wind_bank_seed``; each episode reads a random bank field from a random along-wind offset.
+    5-20 s, onset within 30 s). Turbulence (default ``"moderate"``: sigma_u / U(h) = 10 % at
+    the aerostat, MIL-F-8785C low-altitude model with W20 from the mean profile, von Karman)
+    is a frozen coherent field from a bank of unit-variance fields generated once per process
+    from ``wind_bank_seed``; each episode reads a random bank field from a random along-wind
+    offset, scaled to that episode's mean wind.
     ``reset(options={"wind_speed": U, "perturbation": ...})`` fixes them for one episode.
 
     ## Episode End
@@ -125,8 +127,15 @@ class TetheredAerostatEnv(gym.Env):
     ``gym.make("TetheredAerostat-v0", **kwargs)`` with:
 
     - ``wind_speed=(3.0, 15.0)``: range of the episode's mean wind speed [m/s].
-    - ``turbulence="moderate"``: preset ("none", "light", "moderate", "severe") or a dict of
-      :class:`aerostat_gym.wind.TurbulenceConfig` fields (key "preset" picks the base).
+    - ``turbulence="moderate"``: intensity class ("none", "light", "moderate", "severe":
+      sigma follows each episode's mean wind, :mod:`aerostat_gym.wind.presets`), "config" (the
+      parameter file's ``wind.turbulence`` and ``wind.turbulence_model``), or a dict of
+      :class:`aerostat_gym.wind.TurbulenceConfig` fields (key "preset" picks the base;
+      explicit sigma_u / sigma_v / sigma_w give a fixed, measured-site intensity). The field's
+      heights run from the winch to above the highest point the aerostat reaches at
+      ``winch.max_length`` and its extent follows the longest tether
+      (:func:`aerostat_gym.wind.sizing.field_extent`); ``wind.turbulence_reference_height``
+      sets the advection height.
     - ``perturbation="mixed"``: "none", "displacement", "gust", "mixed" or a dict with keys
       swing [m], lateral [m], pitch [rad], gust_probability, gust_amplitude [m/s] (low, high),
       gust_duration [s] (low, high), gust_onset [s] (low, high).
@@ -153,6 +162,16 @@ class TetheredAerostatEnv(gym.Env):
     ## Version History
 
     - v0: initial release (aerostat-gym 0.1).
+    - v0, unchanged dynamics, observation and reward (bit-identical episodes): ``reward_fn``
+      argument, ``info["peak_tension"]``, ``get_state`` / ``set_state``; the pitch channel's
+      documented sign corrected (positive is nose down, as it always was).
+    - v0, issue 13 (dynamics changed, id kept because the mission names it): turbulence
+      classes scale with each episode's mean wind (MIL-F-8785C, TI 5 / 10 / 15 % at 300 m, was
+      fixed sigma_u 0.8 / 1.6 / 2.4 m/s); fins with Viterna-Corrigan post-stall normal force
+      beyond a 45 deg stall (was C_L flat beyond 16 deg); the turbulence field sized from the
+      configuration (430 m high for the baseline, was 340 m); an optional Froude-Krylov plus
+      added-mass force of accelerating air on the hull (``aerostat.air_inertia``, off by
+      default). Steady-wind trims are unchanged.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}

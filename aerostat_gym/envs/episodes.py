@@ -17,7 +17,14 @@ from ..params import ParameterError, Params, apply_overrides, dumps_toml
 from ..physics.core import euler_angles, rotation_matrix
 from ..physics.packing import pack_params
 from ..physics.state import StateLayout
-from ..physics.wind import mean_wind, set_advection, set_field, set_gust, set_periodic
+from ..physics.wind import (
+    mean_wind,
+    set_advection,
+    set_field,
+    set_field_scale,
+    set_gust,
+    set_periodic,
+)
 from ..sim import Model
 from ..wind.presets import TurbulenceConfig
 from ..wind.synthesis import fft_length, veers_field
@@ -152,8 +159,10 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
     wp = mean_wind(params.wind, U)
     ua = set_advection(wp, cfg.reference_height, cfg.min_advection_speed)
     field_index, offset = _field(cfg, bank_shape, ua, wp, rng)
+    sigmas = _intensity(cfg, wp)
     x0, info = _perturb(x_trim, params, pert, wp, ua, rng)
-    info.update({"wind_speed": U, "field_index": field_index, "field_offset_m": offset})
+    info.update({"wind_speed": U, "field_index": field_index, "field_offset_m": offset,
+                 "turbulence_sigma_m_s": sigmas})
     return Episode(x0, x_trim, float(tension), pack_params(params), wp, field_index, U, params,
                    info)
 
@@ -205,6 +214,55 @@ def _field(cfg, bank_shape, ua, wp, rng) -> tuple[int, float]:
               cfg.upwind_extent)
     set_periodic(wp)
     return index, offset
+
+
+# --- per-episode turbulence intensity (issue 13) -------------------------------------------------
+
+
+#: id -> bank already normalised; weak, so that a bank is still freed with its last
+#: environment (a dead bank's entry goes with it, so an id is never matched stale)
+_UNIT_BANKS: weakref.WeakValueDictionary = weakref.WeakValueDictionary()
+
+
+def unit_bank(cfg: TurbulenceConfig, size: int, seed: int, length: float) -> np.ndarray:
+    """The turbulence bank of ``cfg``'s class with unit-variance fields: :func:`turbulence_bank`
+    of :meth:`TurbulenceConfig.unit`, normalised once by :func:`normalise_bank` (a bank shared
+    through the cache is never rescaled again, so every environment reads the same bits)."""
+    bank = turbulence_bank(cfg.unit(), size, seed, length)
+    if _UNIT_BANKS.get(id(bank)) is not bank:
+        normalise_bank(bank)
+        _UNIT_BANKS[id(bank)] = bank
+    return bank
+
+
+def normalise_bank(bank: np.ndarray) -> np.ndarray:
+    """Scale every field of a bank, per height row and component, to unit mean square, in
+    place; returns the bank.
+
+    A Veers field's variance is itself random (Gaussian Fourier coefficients: the eight fields
+    of the default bank range 0.46-1.40 in variance). Scaling a row by a constant leaves its
+    spectral shape and its coherence with every other row unchanged, so the fields stay valid
+    samples of the spectrum, and each episode's sigma is then the one its class asks for.
+    """
+    n = bank.shape[2]
+    if n == 0:
+        return bank
+    for field in bank:  # one field at a time: no temporary the size of the bank
+        rms = np.sqrt(np.einsum("kjc,kjc->kc", field, field) / n)
+        field /= np.where(rms > 0.0, rms, 1.0)[:, None, :]
+    return bank
+
+
+def _intensity(cfg: TurbulenceConfig, wp: np.ndarray) -> tuple[float, float, float]:
+    """Scale the bank's unit-variance field to this episode's mean wind (in place in wp) and
+    return (sigma_u, sigma_v, sigma_w) [m/s]: the class's sigmas at the episode's U(h) for a
+    wind-scaled class, the explicit ones for a 'fixed' config. Exact, because no intensity
+    model's spectral shape changes with U (:meth:`TurbulenceConfig.unit`)."""
+    if cfg.is_off:
+        return (0.0, 0.0, 0.0)
+    sigmas = cfg.for_wind(wp).sigmas
+    set_field_scale(wp, sigmas)
+    return tuple(float(s) for s in sigmas)
 
 
 def _perturb(x_trim, params, pert, wp, ua, rng) -> tuple[np.ndarray, dict]:

@@ -66,6 +66,14 @@ def weights_vector(weights: dict | None) -> np.ndarray:
     return np.array([w[k] for k in REWARD_TERMS])
 
 
+def reward_table(weights: dict | None = None) -> list[dict]:
+    """Rows (term, weight, formula) of the default reward, in REWARD_TERMS order, with the
+    given weight overrides (like :func:`aerostat_gym.envs.observation_table`)."""
+    w = weights_vector(weights)
+    return [{"term": k, "weight": float(w[i]), "formula": REWARD_DOC[k]}
+            for i, k in enumerate(REWARD_TERMS)]
+
+
 def check_reward_fn(fn) -> RewardFn | None:
     """``fn`` if it is None or callable, else a ValueError naming what was given."""
     if fn is not None and not callable(fn):

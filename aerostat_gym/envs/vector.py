@@ -31,13 +31,15 @@ DEFAULT_MAX_EPISODE_STEPS = 600
 
 class TetheredAerostatVectorEnv(VectorEnv):
     """``num_envs`` copies of :class:`TetheredAerostatEnv` (same arguments, see its docstring)
-    stepped together; ``max_episode_steps`` truncates each episode (600 by default)."""
+    stepped together; ``max_episode_steps`` truncates each episode (600 by default);
+    ``threads`` sets the threads of the batched step (1 to ``NUMBA_NUM_THREADS``, default all:
+    on a machine shared with other busy jobs, ``threads=1`` is the safe choice)."""
 
     metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
 
     def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
-                 render_mode: str | None = None, **kwargs):
+                 render_mode: str | None = None, threads: int | None = None, **kwargs):
         if not (isinstance(num_envs, int) and num_envs >= 1):
             raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
         self.autoreset_mode = AutoresetMode(autoreset_mode)
@@ -52,7 +54,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
         self.task = TaskConfig(**kwargs)
         self.max_episode_steps = int(max_episode_steps or DEFAULT_MAX_EPISODE_STEPS)
         self.num_envs = num_envs
-        self.batch = EnvBatch(self.task, num_envs)
+        self.batch = EnvBatch(self.task, num_envs, threads)
         b = self.batch
         self.single_action_space = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
         self.single_observation_space = gym.spaces.Box(b.obs_low, b.obs_high, dtype=np.float32)

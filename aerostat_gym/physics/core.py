@@ -22,8 +22,15 @@ Model ([LN02]; equations reconstructed in docs/parameters.md section 4)
 - Aerostat: buoyancy B = rho g V at the centre of buoyancy, weight at the CM, Jones & DeLaurier
   hull forces and nose moment (applied as forces at the nose plus the moment, which equals
   forces at the centre of pressure and has no 0/0 at alpha -> 0), three fins with local alpha
-  from the air-relative velocity at their own point (V + omega x r - wind), linear lift to
-  stall then flat, induced drag from the unsaturated C_L.
+  from the air-relative velocity at their own point (V + omega x r - wind), linear lift and
+  induced drag to a 3-D stall angle, then the Viterna-Corrigan post-stall normal force out to
+  90 deg and its mirror image in reverse flow (:func:`fin_coefficients`; the paper's flat
+  post-stall lift is the option ``fins.post_stall = 'flat'``).
+- Air inertia: in accelerating air (turbulence, gusts) the hull feels the Froude-Krylov force
+  rho V dW/dt plus the added-mass force k_i rho V dW_i/dt per body axis, applied at the
+  centre of buoyancy (:func:`_air_inertia`); dW/dt is the local time derivative at the hull
+  point averaged over the hull length along the wind
+  (:func:`aerostat_gym.physics.wind.air_acceleration`). Zero in steady wind.
 - Inertia: translational added mass m_e = m + k rho V per body axis. The inertial terms use
   Kirchhoff's form M_e dV/dt + omega x (M_e V) = F and I domega/dt + omega x I omega
   + V x (M_a V) = M with V the ground-relative CM velocity. This is the rigid-body mechanics of
@@ -44,6 +51,8 @@ from numba import njit
 
 from .packing import (
     P_AF,
+    P_AILEN,
+    P_AIRINERTIA,
     P_ANCHOR,
     P_ASTALL,
     P_BUOY,
@@ -51,6 +60,7 @@ from .packing import (
     P_CD0F,
     P_CD0H,
     P_CDC,
+    P_CDMAX,
     P_CDN,
     P_CLA,
     P_DASHPOT,
@@ -77,6 +87,7 @@ from .packing import (
     P_NEL,
     P_NFIN,
     P_NOSE,
+    P_POSTSTALL,
     P_RHO,
     P_SH,
     P_W_AMAX,
@@ -109,7 +120,17 @@ from .state import (
     scratch_offset,
     tension_offset,
 )
-from .wind import W_DIRC, W_DIRS, W_GUST_ON, W_PROFILE, W_TURB_ON, W_UREF, air_velocity, mean_speed
+from .wind import (
+    W_DIRC,
+    W_DIRS,
+    W_GUST_ON,
+    W_PROFILE,
+    W_TURB_ON,
+    W_UREF,
+    air_acceleration,
+    air_velocity,
+    mean_speed,
+)
 
 # fastmath without the no-NaN/no-Inf assumptions, so non-finite states are still detected.
 FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
@@ -412,6 +433,50 @@ def _hull(u, v, wv, p):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def fin_coefficients(alpha, p):
+    """Lift and drag coefficients (C_L, C_D) of a fin at local incidence alpha in [-pi, pi].
+
+    Below the stall angle alpha_s: C_L = a alpha, C_D = C_D0 + k (a alpha)^2 (the paper's
+    linear fin, so the trim and the linearization are [LN02]'s). Beyond it, with
+    ``post_stall = 'viterna'``, the Viterna-Corrigan extrapolation (NASA CP-2230, 1982), matched
+    to (C_L, C_D) at alpha_s so both are continuous there::
+
+        C_L = A1 sin 2 alpha + A2 cos^2 alpha / sin alpha,  A1 = C_D,max / 2,
+        A2 = (C_Ls - C_D,max sin alpha_s cos alpha_s) sin alpha_s / cos^2 alpha_s
+        C_D = C_D,max sin^2 alpha + B2 cos alpha,  B2 = (C_Ds - C_D,max sin^2 alpha_s) / cos alpha_s
+
+    so the normal force C_N = C_L cos alpha + C_D sin alpha grows to C_D,max at 90 deg, as a
+    plate's does. Reverse flow (|alpha| > 90 deg) mirrors the plate: C_L(pi - alpha) = -C_L(alpha),
+    C_D(pi - alpha) = C_D(alpha); C_L is odd and C_D even in alpha. With ``post_stall = 'flat'``
+    C_L is held at +-a alpha_s and C_D keeps the unsaturated induced term ([LN02]'s rule).
+    """
+    a_st = p[P_ASTALL]
+    cla = p[P_CLA]
+    if p[P_POSTSTALL] == 0.0:
+        return (cla * min(max(alpha, -a_st), a_st),
+                p[P_CD0F] + cla * cla * alpha * alpha * p[P_KIND])
+    aa = abs(alpha)
+    reverse = aa > 0.5 * math.pi
+    am = math.pi - aa if reverse else aa  # incidence from the nearer edge, in [0, pi/2]
+    if am <= a_st:
+        cl = cla * am
+        cd = p[P_CD0F] + cl * cl * p[P_KIND]
+    else:
+        cdm = p[P_CDMAX]
+        ss, cs = math.sin(a_st), math.cos(a_st)
+        cls = cla * a_st
+        cds = p[P_CD0F] + cls * cls * p[P_KIND]
+        sa, ca = math.sin(am), math.cos(am)
+        a2 = (cls - cdm * ss * cs) * ss / (cs * cs)
+        b2 = (cds - cdm * ss * ss) / cs
+        cl = cdm * sa * ca + a2 * ca * ca / sa
+        cd = cdm * sa * sa + b2 * ca
+    if reverse:
+        cl = -cl
+    return (cl if alpha >= 0.0 else -cl), cd
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _fin(u, v, wv, p, i):
     """Lift and drag of fin i (body frame) from its air-relative velocity (u, v, w)."""
     b = P_FIN + 9 * i
@@ -422,10 +487,7 @@ def _fin(u, v, wv, p, i):
     if V2 < 1e-20:
         return 0.0, 0.0, 0.0
     alpha = fast_atan2(wn, un)
-    a_st = p[P_ASTALL]
-    cla = p[P_CLA]
-    cl = cla * min(max(alpha, -a_st), a_st)  # flat beyond stall
-    cd = p[P_CD0F] + cla * cla * alpha * alpha * p[P_KIND]  # induced drag from the unsaturated C_L
+    cl, cd = fin_coefficients(alpha, p)
     q = 0.5 * p[P_RHO] * p[P_AF] * V2
     qin = math.sqrt(un * un + wn * wn)
     fx = fy = fz = 0.0
@@ -466,7 +528,7 @@ def rhs(t, x, u, p, wp, wf, dx, w):
     R = _rotation(x[o + S_PHI], x[o + S_THETA], x[o + S_PSI])
     npts = _kinematics(x, p, R, w)
     wind_batch(t, w, npts, points_offset(n), wp, wf)
-    loads = _aero_loads(x, p, w, R, o)
+    loads = _aero_loads(t, x, p, wp, wf, w, R, o)
     Tw = _tether(x, p, w)
     F = node_force_offset(n)
     # moving nodes: position' = velocity, velocity' = force / node mass (views: no wraparound)
@@ -483,10 +545,11 @@ def rhs(t, x, u, p, wp, wf, dx, w):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def _aero_loads(x, p, w, R, o):
+def _aero_loads(t, x, p, wp, wf, w, R, o):
     """Body-frame force and moment about the CM of everything on the aerostat except the
     tether: weight at the CM, buoyancy at the CB, hull and fins (winds at the hull and fin
-    points are read from the work array)."""
+    points are read from the work array), and the air-inertia force at the CB when the air
+    accelerates."""
     n = int(p[P_NEL])
     nf = int(p[P_NFIN])
     vx, vy, vz = x[o + S_VX], x[o + S_VY], x[o + S_VZ]
@@ -524,7 +587,30 @@ def _aero_loads(x, p, w, R, o):
         fu, fv, fw = _air_body(ub, vb, wb, pp, qq, rr, cx, cy, cz, R, w[k], w[k + 1], w[k + 2])
         ffx, ffy, ffz = _fin(fu, fv, fw, p, i)
         Fx, Fy, Fz, Mx, My, Mz = _add_load(Fx, Fy, Fz, Mx, My, Mz, cx, cy, cz, ffx, ffy, ffz)
+    if p[P_AIRINERTIA] != 0.0 and (wp[W_GUST_ON] != 0.0 or (wp[W_TURB_ON] != 0.0 and wf.shape[1] > 1)):
+        hp = points_offset(n) + 3 * n  # the hull point (centre of buoyancy), inertial
+        aix, aiy, aiz = _air_inertia(t, w[hp], w[hp + 1], w[hp + 2], p, R, wp, wf)
+        Fx, Fy, Fz, Mx, My, Mz = _add_load(Fx, Fy, Fz, Mx, My, Mz, xb, yb, zb, aix, aiy, aiz)
     return Fx, Fy, Fz, Mx, My, Mz
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _air_inertia(t, px, py, pz, p, R, wp, wf):
+    """Body-frame force of accelerating air on the hull at inertial point (px, py, pz).
+
+    The pressure gradient that accelerates the air at a = dW/dt (averaged over the hull's
+    length along the wind) pushes the displaced volume with rho V a (Froude-Krylov); the air
+    the hull must accelerate with it adds k_i rho V a_i along body axis i (added mass; the
+    body's own acceleration is in the effective mass). In total
+    F_i = (rho V + m_a,i) a_i = (1 + k_i) rho V a_i, with rho V = B / g.
+    """
+    ax, ay, az = air_acceleration(px, py, pz, t, wp, wf, p[P_AILEN])
+    # body components R^T a
+    abx = R[0] * ax + R[3] * ay + R[6] * az
+    aby = R[1] * ax + R[4] * ay + R[7] * az
+    abz = R[2] * ax + R[5] * ay + R[8] * az
+    rv = p[P_BUOY] / p[P_G]
+    return (rv + p[P_MA]) * abx, (rv + p[P_MA + 1]) * aby, (rv + p[P_MA + 2]) * abz
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")

@@ -247,7 +247,7 @@ def si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats):
                 for c in range(3):
                     tmp[r_, c] = G[j, r_, c] + G[j + 1, r_, c] + (mn if r_ == c else 0.0)
             if j < nm - 1:
-                _schur3(tmp, G[j + 1], Sinv[j + 1], Y[j], Y[j + 1])
+                _eliminate(tmp, G[j + 1], Sinv[j + 1], Y[j], Y[j + 1])
             _inv3(tmp, Sinv[j])
         # aerostat block: M0 + J^T G0 J, minus the coupling to node 1
         _aerostat_matrix(x, p, R, o, S0)
@@ -258,7 +258,7 @@ def si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats):
             for c in range(6):
                 S0[r_, c] += J[0, r_] * GJ[0, c] + J[1, r_] * GJ[1, c] + J[2, r_] * GJ[2, c]
         if nm > 0:
-            _schur_top(S0, y0, GJ, Sinv[0], Y[0])
+            _eliminate(S0, GJ, Sinv[0], y0, Y[0])
         _solve_dense(S0, y0)  # y0 now holds [dv_cm; domega]
         if p[P_FIXED] != 0.0:
             for c in range(6):
@@ -302,43 +302,28 @@ def si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def _schur3(D, Gc, Sinv_below, y, y_below):
-    """D -= Gc Sinv_below Gc ; y += Gc Sinv_below y_below (eliminating the node below)."""
-    for r_ in range(3):
-        for c in range(3):
+def _eliminate(D, C, Sinv_below, y, y_below):
+    """Eliminate the node below from a block row: D -= C^T S^-1 C, y += C^T S^-1 y_below.
+
+    C couples the node below (3 rows) to this block's unknowns (columns: 3 for a tether node,
+    where C is the symmetric element matrix G, or 6 for the aerostat, where C = G0 J).
+    """
+    m = D.shape[0]
+    for r_ in range(m):
+        for c in range(m):
             s = 0.0
             for k in range(3):
                 for l2 in range(3):
-                    s += Gc[r_, k] * Sinv_below[k, l2] * Gc[l2, c]
+                    s += C[k, r_] * Sinv_below[k, l2] * C[l2, c]
             D[r_, c] -= s
-    for r_ in range(3):
+    for r_ in range(m):
         s = 0.0
         for k in range(3):
             t = 0.0
             for l2 in range(3):
                 t += Sinv_below[k, l2] * y_below[l2]
-            s += Gc[r_, k] * t
+            s += C[k, r_] * t
         y[r_] += s
-
-
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
-def _schur_top(S0, y0, GJ, Sinv1, y1):
-    """Eliminate node 1 from the aerostat block: S0 -= (G0 J)^T S1^-1 (G0 J), y0 += (G0 J)^T S1^-1 y1."""
-    for r_ in range(6):
-        for c in range(6):
-            s = 0.0
-            for k in range(3):
-                for l2 in range(3):
-                    s += GJ[k, r_] * Sinv1[k, l2] * GJ[l2, c]
-            S0[r_, c] -= s
-    for r_ in range(6):
-        s = 0.0
-        for k in range(3):
-            t = 0.0
-            for l2 in range(3):
-                t += Sinv1[k, l2] * y1[l2]
-            s += GJ[k, r_] * t
-        y0[r_] += s
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)

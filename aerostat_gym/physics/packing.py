@@ -33,6 +33,11 @@ _FIELDS = [
     ("W_TAU", 1), ("W_LMIN", 1), ("W_LMAX", 1), ("W_FRICTION_V", 1),
     # 1 holds the aerostat fixed (tether-only runs, e.g. the comparison with MoorDyn)
     ("FIXED", 1),
+    # large-angle fins: 1 Viterna-Corrigan post-stall, 0 [LN02]'s flat C_L; deep-stall C_D,max
+    ("POSTSTALL", 1), ("CDMAX", 1),
+    # 1: Froude-Krylov plus added-mass force of accelerating air on the hull; the length [m]
+    # along the wind over which the air acceleration is averaged (the hull length)
+    ("AIRINERTIA", 1), ("AILEN", 1),
 ]
 # Offsets into the packed vector (literal, so numba folds them; checked against _FIELDS by the tests).
 P_G = 0
@@ -82,7 +87,11 @@ P_W_LMIN = 133
 P_W_LMAX = 134
 P_W_FRICTION_V = 135
 P_FIXED = 136
-P_SIZE = 137
+P_POSTSTALL = 137
+P_CDMAX = 138
+P_AIRINERTIA = 139
+P_AILEN = 140
+P_SIZE = 141
 
 
 def pack_params(params: Params) -> np.ndarray:
@@ -109,6 +118,10 @@ def pack_params(params: Params) -> np.ndarray:
     p[P_AF], p[P_CLA], p[P_ASTALL], p[P_CD0F] = (f.planform_area, f.CL_alpha,
                                                  math.radians(f.alpha_stall_deg), f.CD0)
     p[P_KIND] = 1.0 / (math.pi * f.aspect_ratio * f.oswald_e)
+    p[P_POSTSTALL] = 1.0 if f.post_stall == "viterna" else 0.0
+    p[P_CDMAX] = d.fin_cd_max
+    p[P_AIRINERTIA] = 1.0 if a.air_inertia else 0.0
+    p[P_AILEN] = a.length
     for i, pan in enumerate(f.panels):
         g = math.radians(pan.roll_angle_deg)
         span = np.array([0.0, math.sin(g), math.cos(g)])

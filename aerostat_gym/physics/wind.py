@@ -63,9 +63,14 @@ W_FIELD_XUP = 21  # ... and up to this far upwind of the anchor [m]
 W_FIELD_IDZ = 22
 W_FIELD_IDT = 23
 W_TAYLOR_IDX = 24
+# per-episode scale of the field's u, v, w (1 for a field generated at its own sigmas; the
+# environment reads a bank of unit-variance fields and puts each episode's sigmas here)
+W_FIELD_SU = 25
+W_FIELD_SV = 26
+W_FIELD_SW = 27
 # 1: the field is periodic in time with its own length (an inverse-FFT synthesis is), and is
 # read modulo that length, so an episode of any length is served; 0: edge values are held
-W_FIELD_PERIODIC = 25
+W_FIELD_PERIODIC = 28
 W_SIZE = 32
 
 PROFILES = {"uniform": 0, "power": 1, "log": 2}
@@ -94,7 +99,17 @@ def pack_wind(profile: str = "uniform", speed: float = 0.0, direction_deg: float
     wp[W_DIRC], wp[W_DIRS] = math.cos(a), math.sin(a)
     wp[W_ZMIN] = max(roughness_length * 1.01, 0.5)
     wp[W_TAYLOR_U] = max(speed, MIN_ADVECTION_SPEED)
+    wp[W_FIELD_SU] = wp[W_FIELD_SV] = wp[W_FIELD_SW] = 1.0
     return wp
+
+
+def set_field_scale(wp: np.ndarray, sigmas) -> None:
+    """Scale the field's u, v, w by ``sigmas`` (in place): a unit-variance field then has these
+    standard deviations [m/s]."""
+    su, sv, sw = (float(s) for s in sigmas)
+    if not all(math.isfinite(s) and s >= 0 for s in (su, sv, sw)):
+        raise ValueError(f"field scales must be finite and >= 0, got {sigmas!r}")
+    wp[W_FIELD_SU], wp[W_FIELD_SV], wp[W_FIELD_SW] = su, sv, sw
 
 
 def mean_wind(wind, speed: float | None = None) -> np.ndarray:
@@ -286,11 +301,54 @@ def _air_velocity(x, y, z, t, wp, wf):
         wa += wp[W_GUST_AW] * g
     if wp[W_TURB_ON] != 0.0 and wf.shape[1] > 1:
         du, dv, dw = _field_sample(xa, z, t, wp, wf)
-        ua += du
-        va += dv
-        wa += dw
+        ua += wp[W_FIELD_SU] * du
+        va += wp[W_FIELD_SV] * dv
+        wa += wp[W_FIELD_SW] * dw
     # rotate mean-wind axes (u along the heading, v to its left) to inertial X, Y
     return c * ua - s * va, s * ua + c * va, wa
+
+
+@njit(**_JIT, inline="always")
+def _air_acceleration(x, y, z, t, wp, wf, length):
+    """Body of :func:`air_acceleration`."""
+    tau = length / wp[W_TAYLOR_U]
+    if wp[W_TURB_ON] != 0.0 and wf.shape[1] > 1:
+        tau = max(tau, wp[W_FIELD_DT])
+    if tau <= 0.0:
+        return 0.0, 0.0, 0.0
+    h = 0.5 * tau
+    u1, v1, w1 = _air_velocity(x, y, z, t + h, wp, wf)
+    u0, v0, w0 = _air_velocity(x, y, z, t - h, wp, wf)
+    it = 1.0 / tau
+    return (u1 - u0) * it, (v1 - v0) * it, (w1 - w0) * it
+
+
+@njit(**_JIT)
+def air_acceleration(x, y, z, t, wp, wf, length):
+    """Local time derivative dW/dt (inertial, m/s^2) of the air velocity at the fixed point
+    (x, y, z) [m] and time t [s], averaged along the wind over ``length`` [m] (a hull's).
+
+    Notes
+    -----
+    The difference [W(t + tau/2) - W(t - tau/2)] / tau with tau = length / U_a (at least one
+    field time step) is exactly the time derivative of W averaged over the window tau, i.e. (by
+    Taylor's frozen flow) of W averaged over ``length`` along the wind. A body feels the
+    pressure gradient averaged over its volume, so eddies shorter than the hull add nothing;
+    without the average the acceleration of a von Karman field grows without bound with the
+    grid resolution (its spectrum f^2 S(f) ~ f^(1/3)). The steady mean wind cancels exactly; a
+    field linear in time gives its slope exactly.
+
+    This is the acceleration of the air past a point held in place (what a moored body sees).
+    The frozen field advected at U_a has, by construction, no material acceleration
+    DW/Dt = dW/dt + U_a dW/dx_a = 0; the local derivative is the one the air-inertia force
+    uses, as in Morison's equation for a body held in a wave field.
+    """
+    return _air_acceleration(x, y, z, t, wp, wf, length)
+
+
+def air_is_unsteady(wp: np.ndarray, wf: np.ndarray) -> bool:
+    """True when the air can accelerate: a gust or a turbulence field is switched on."""
+    return bool(wp[W_GUST_ON] != 0.0 or (wp[W_TURB_ON] != 0.0 and wf.shape[1] > 1))
 
 
 @njit(**_JIT)

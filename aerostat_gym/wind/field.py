@@ -52,8 +52,9 @@ def build_wind(mean, turbulence: str | TurbulenceConfig | dict | None = "none",
         toward], ``shear_exponent`` [-], ``roughness_length`` [m]; an object with those
         attributes (:class:`aerostat_gym.params.WindParams`); or a vector from ``pack_wind``.
     turbulence : str, TurbulenceConfig, dict or None
-        Preset name ('none', 'light', 'moderate', 'severe'), a config, or a dict of config
-        fields (key 'preset' picks the base). None means 'none'.
+        Intensity class ('none', 'light', 'moderate', 'severe': sigma follows this mean wind,
+        see :mod:`aerostat_gym.wind.presets`), a config, or a dict of config fields (key
+        'preset' picks the base; explicit sigma_* make it 'fixed'). None means 'none'.
     duration : float
         Episode length [s] the field must cover (> 0).
     rng : numpy.random.Generator
@@ -85,6 +86,7 @@ def build_wind(mean, turbulence: str | TurbulenceConfig | dict | None = "none",
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise ValueError(f"wind field duration must be a finite number > 0 [s], got {duration!r}")
     wp = mean_vector(mean)
+    cfg = cfg.for_wind(wp)  # a wind-scaled class: its sigmas in this mean wind
     ua = set_advection(wp, cfg.reference_height, cfg.min_advection_speed)
     if gust is not None:
         _apply_gust(wp, gust, ua)

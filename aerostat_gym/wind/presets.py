@@ -1,26 +1,44 @@
-"""Turbulence configuration and the named presets ``none``, ``light``, ``moderate``, ``severe``.
+"""Turbulence configuration and the named intensity classes ``none``, ``light``, ``moderate``,
+``severe``.
 
-The presets follow the recommended parameter set for a 300 m tether and an 18 m aerostat at a
-Penticton-like site (aerostat at h ~ 250-310 m, z0 ~ 0.05 m, nominal U(h) ~ 8 m/s):
+The classes are wind-scaled: sigma_u, sigma_v, sigma_w follow from each episode's mean wind at
+the aerostat's height h (``reference_height``, 300 m) through a cited model
+(``intensity_model``), so the turbulence intensity, not sigma, is what a class fixes:
 
-==========  =======  =======  =======  =====  ======  ======  =============================
-preset      sigma_u  sigma_v  sigma_w  L_u    L_v     L_w     meaning
-==========  =======  =======  =======  =====  ======  ======  =============================
-none        0        0        0        300    120     60      mean wind only (the paper)
-light       0.8      0.64     0.48     300    120     60      TI 10 % at 8 m/s
-moderate    1.6      1.28     0.96     300    120     60      TI 20 % at 8 m/s
-severe      2.4      1.92     1.44     300    120     60      TI 30 % at 8 m/s, 16 % at 15 m/s
-==========  =======  =======  =======  =====  ======  ======  =============================
+- ``"mil"`` (default): MIL-F-8785C / MIL-HDBK-1797 low-altitude model, h in ft:
+  sigma_w = 0.1 W20 f, sigma_u = sigma_v = sigma_w / (0.177 + 0.000823 h)^0.4, L_u = 2 L_v =
+  h / (0.177 + 0.000823 h)^1.2, L_w = h / 2 (1797 convention), with W20 the configured mean
+  profile's own speed at 20 ft (6.096 m) and f the class factor below.
+- ``"neutral"``: neutral atmospheric boundary layer (ESDU 85020 family, Counihan; Panofsky &
+  Dutton): sigma_u = 2.5 u* f, sigma_v = 2.0 u* f, sigma_w = 1.25 u* f with
+  u* = kappa U(h) / ln(h / z0), kappa = 0.4, z0 the profile's roughness length; intensity
+  sigma_u / U(h) = f / ln(h / z0), whatever the wind speed. Length scales: the config's L_u, L_v, L_w.
+- ``"iec"``: IEC 61400-1 Ed. 3 normal turbulence model, sigma_u = I_ref (0.75 U(h) + 5.6) m/s,
+  sigma_v = 0.8 sigma_u, sigma_w = 0.5 sigma_u (Kaimal, Annex B), I_ref = 0.12 / 0.14 / 0.16
+  (classes C / B / A) for light / moderate / severe; Kaimal integral scales 340.2 / 113.4 /
+  27.72 m. A 90th-percentile design value for hub heights near 100 m: harsher than typical.
+- ``"fixed"``: the explicit ``sigma_u``, ``sigma_v``, ``sigma_w`` (for a measured site).
 
-(sigma in m/s, L in m, MIL-HDBK-1797 convention, so every L is the integral length scale.)
-Reasoning: sigma_u is the MIL-F-8785C low-altitude rule, sigma_u = 0.1 W20 /
-(0.177 + 0.000823 h[ft])^0.4, with the MIL severity winds W20 = 15 / 30 / 45 kt: 0.79 / 1.59 /
-2.38 m/s at 280 m and 0.78 / 1.55 / 2.33 m/s at 300 m, rounded to 0.8 / 1.6 / 2.4. 'light' is
-also the notes' nominal sigma_u ~ 0.10 U(h) for the neutral log law. sigma_v / sigma_u = 0.8
-and sigma_w / sigma_u = 0.6 sit between IEC 61400-1 (0.8 / 0.5) and the nearly isotropic MIL
-model at 280 m. L_u = 300 m is between MIL (304 m),
-IEC (340 m), Eurocode (357 m) and Counihan (220 m); L_v = 120 m and L_w = 60 m are integral
-scales where standards disagree (IEC: w 28 m; MIL: w 140 m), so randomise them in training.
+Class factor f: light 0.5, moderate 1, severe 1.5, the ratios of MIL-F-8785C's severity winds
+(W20 = 15 / 30 / 45 kt). Turbulence intensity sigma_u / U(h) at h = 300 m for the baseline
+(uniform profile, z0 = 0.05 m):
+
+==========  ===========  ===============  =========================  ============================
+class       mil          neutral          iec (4 / 8 / 16 m/s)       source band
+==========  ===========  ===============  =========================  ============================
+none        0            0                0                          mean wind only ([LN02])
+light       5.0 %        5.7 %            25.8 / 17.4 / 13.2 %       stable: < 5-6 % (notes)
+moderate    10.1 %       11.5 %           30.1 / 20.3 / 15.4 %       neutral 1/ln(h/z0): 9.7-12.5 %
+severe      15.1 %       17.2 %           34.4 / 23.2 / 17.6 %       convective: up to 2 x neutral
+==========  ===========  ===============  =========================  ============================
+
+(neutral band for z0 = 0.01-0.1 m; with a log profile over z0 = 0.05 m the MIL W20 drops to
+0.55 U(300 m) and its intensities to 2.8 / 5.5 / 8.3 %.) Scaling one frozen unit-variance
+field by these sigmas is exact: none of the three models' spectral shapes (length scales,
+coherence) depends on the wind speed, only on the height, and the spatial field is the same
+for every U (Taylor), so the environment keeps a bank of unit fields and scales them per
+episode (:func:`TurbulenceConfig.for_wind`).
+
 Coherence: IEC 61400-1 Ed.3 exponential model, a = 12, L_c = 340 m for u (above 60 m), v and w
 with L_c scaled by 2.7/8.1 and 0.66/8.1 (pyconturb 'iec3d').
 """
@@ -32,10 +50,29 @@ import math
 import numbers
 from dataclasses import dataclass, field, fields
 
-from ..physics.wind import MIN_ADVECTION_SPEED
-from .spectra import CONVENTIONS, KT, MODELS, W20_KT, integral_scale, mil_low_altitude, to_8785c
+from ..physics.wind import MIN_ADVECTION_SPEED, W_Z0, mean_speed
+from .spectra import (
+    CONVENTIONS,
+    FT,
+    KT,
+    MODELS,
+    W20_KT,
+    integral_scale,
+    mil_low_altitude,
+    to_8785c,
+)
 
 METHODS = ("spectral", "filter")
+INTENSITY_MODELS = ("fixed", "mil", "neutral", "iec")
+INTENSITY_CLASSES = ("none", "light", "moderate", "severe")
+#: class factor on the model's sigma: MIL-F-8785C severity winds 15 / 30 / 45 kt, over 30 kt
+CLASS_FACTOR = {"none": 0.0, "light": 0.5, "moderate": 1.0, "severe": 1.5}
+#: IEC 61400-1 Ed. 3 reference intensities I_ref of classes C / B / A
+IEC_IREF = {"none": 0.0, "light": 0.12, "moderate": 0.14, "severe": 0.16}
+IEC_SCALES = (340.2, 113.4, 27.72)  # [m] Kaimal integral scales 8.1, 2.7, 0.66 x 42 m (IEC Annex B)
+KARMAN = 0.4  # von Karman constant
+NEUTRAL_RATIOS = (2.5, 2.0, 1.25)  # sigma_u, sigma_v, sigma_w over u* (neutral surface layer)
+W20_HEIGHT = 20.0 * FT  # [m] the MIL model's reference wind height, 20 ft
 
 
 def _f(unit: str, status: str, doc: str, default):
@@ -85,11 +122,23 @@ class TurbulenceConfig:
     upwind_extent: float = _f("m", "ESTIMATE", "farthest upwind point the field serves", 50.0)
     min_advection_speed: float = _f("m/s", "ESTIMATE", "floor of U_a (Taylor fails below 1-2 m/s)",
                                     MIN_ADVECTION_SPEED)
+    intensity_model: str = _f("-", "SOURCED", "how sigma follows the mean wind: 'fixed' (the "
+                              "sigma_* fields), 'mil' (MIL-F-8785C low altitude, W20 from the "
+                              "mean profile), 'neutral' (boundary layer, sigma_u = 2.5 u*) or "
+                              "'iec' (IEC 61400-1 normal turbulence model)", "fixed")
+    intensity: str = _f("-", "SOURCED", "intensity class of a wind-scaled model: none, light, "
+                        "moderate or severe (MIL severity ratios 15 / 30 / 45 kt; IEC C / B / A)",
+                        "moderate")
 
     def __post_init__(self) -> None:
         _check_choice("model", self.model, MODELS)
         _check_choice("method", self.method, METHODS)
         _check_choice("convention", self.convention, CONVENTIONS)
+        _check_choice("intensity_model", self.intensity_model, INTENSITY_MODELS)
+        _check_choice("intensity", self.intensity, INTENSITY_CLASSES)
+        if self.intensity_model != "fixed" and any(self.sigmas):
+            raise ValueError("explicit turbulence sigma_u / sigma_v / sigma_w need intensity_model "
+                             f"'fixed', got intensity_model {self.intensity_model!r}")
         if self.method == "filter" and self.model != "dryden":
             raise ValueError("turbulence method 'filter' (exact forming filters) needs model "
                              f"'dryden', got model {self.model!r}")
@@ -112,8 +161,82 @@ class TurbulenceConfig:
 
     @property
     def is_off(self) -> bool:
-        """True when all intensities are zero (no field is generated)."""
-        return not any(self.sigmas)
+        """True when all intensities are zero or the class is 'none' (no field is generated)."""
+        if self.intensity_model == "fixed":
+            return not any(self.sigmas)
+        return self.intensity == "none"
+
+    @property
+    def wind_scaled(self) -> bool:
+        """True when sigma follows the mean wind (any intensity model but 'fixed')."""
+        return self.intensity_model != "fixed"
+
+    def model_sigmas(self, speed: float, w20: float, z0: float) -> tuple[float, float, float]:
+        """(sigma_u, sigma_v, sigma_w) [m/s] of the intensity model.
+
+        Parameters
+        ----------
+        speed : float
+            Mean wind speed U(h) at ``reference_height`` [m/s].
+        w20 : float
+            Mean wind speed at 20 ft (6.096 m) [m/s] (the MIL model's W20).
+        z0 : float
+            Roughness length [m] (the neutral model's u* = kappa U(h) / ln(h / z0)).
+        """
+        for name, v in (("speed", speed), ("w20", w20)):
+            if not (math.isfinite(v) and v >= 0):
+                raise ValueError(f"turbulence {name} must be finite and >= 0 [m/s], got {v!r}")
+        if self.intensity_model == "fixed":
+            return self.sigmas
+        f = CLASS_FACTOR[self.intensity]
+        h = self.reference_height
+        if self.intensity_model == "mil":
+            mil = mil_low_altitude(h, w20)
+            return (f * mil["sigma_u"], f * mil["sigma_v"], f * mil["sigma_w"])
+        if self.intensity_model == "neutral":
+            if not (math.isfinite(z0) and 0 < z0 < h):
+                raise ValueError(f"the neutral turbulence model needs 0 < z0 < reference_height, "
+                                 f"got z0 = {z0!r} m")
+            ustar = KARMAN * speed / math.log(h / z0)
+            return tuple(f * r * ustar for r in NEUTRAL_RATIOS)
+        su = IEC_IREF[self.intensity] * (0.75 * speed + 5.6)
+        return (su, 0.8 * su, 0.5 * su)
+
+    def model_scales(self) -> tuple[float, float, float]:
+        """(L_u, L_v, L_w) [m] in the config's ``convention``: the MIL low-altitude scales at
+        ``reference_height`` for 'mil', the Kaimal integral scales for 'iec', else the
+        config's own L_u, L_v, L_w."""
+        if self.intensity_model == "mil":
+            mil = mil_low_altitude(self.reference_height, 0.0, self.model, self.convention)
+            return (mil["L_u"], mil["L_v"], mil["L_w"])
+        if self.intensity_model == "iec":
+            return tuple(L if self.convention == "1797" or k == 0 else 2.0 * L
+                         for k, L in enumerate(IEC_SCALES))
+        return (self.L_u, self.L_v, self.L_w)
+
+    def for_wind(self, wp) -> TurbulenceConfig:
+        """The explicit ('fixed') config of this class in the mean wind ``wp``.
+
+        ``wp`` is a packed mean-wind vector (:func:`aerostat_gym.physics.wind.pack_wind`);
+        U(h) is its speed at ``reference_height``, W20 its speed at 20 ft and z0 its roughness
+        length. A 'fixed' config is returned unchanged.
+        """
+        if not self.wind_scaled:
+            return self
+        speed = float(mean_speed(self.reference_height, wp))
+        w20 = float(mean_speed(W20_HEIGHT, wp))
+        su, sv, sw = self.model_sigmas(speed, w20, float(wp[W_Z0]))
+        L_u, L_v, L_w = self.model_scales()
+        return self.replace(intensity_model="fixed", sigma_u=su, sigma_v=sv, sigma_w=sw,
+                            L_u=L_u, L_v=L_v, L_w=L_w)
+
+    def unit(self) -> TurbulenceConfig:
+        """The explicit config with unit sigmas and this class's length scales: the frozen
+        field the environment scales per episode by :meth:`for_wind`'s sigmas (exact, since no
+        model's spectral shape depends on the wind speed)."""
+        L_u, L_v, L_w = self.model_scales()
+        return self.replace(intensity_model="fixed", sigma_u=1.0, sigma_v=1.0, sigma_w=1.0,
+                            L_u=L_u, L_v=L_v, L_w=L_w)
 
     def scales_8785c(self) -> tuple[float, float, float]:
         """Length scales converted to the MIL-F-8785C convention used by the spectra [m]."""
@@ -135,8 +258,9 @@ class TurbulenceConfig:
         return self.z_min, self.dz, n
 
     def replace(self, **changes) -> TurbulenceConfig:
-        """Copy with fields replaced (validated again)."""
-        return dataclasses.replace(self, **changes)
+        """Copy with fields replaced (validated again). Explicit sigma_* without an
+        ``intensity_model`` make the copy 'fixed' (a measured site's values)."""
+        return dataclasses.replace(self, **_explicit_sigmas(changes))
 
     @classmethod
     def from_mil(cls, severity: str | float, height: float = 300.0, model: str = "von_karman",
@@ -166,17 +290,10 @@ def _check_number(name: str, value, allow_zero: bool) -> None:
         raise ValueError(f"turbulence {name} must be a finite number {need}, got {value!r}")
 
 
-def _preset(sigma_u: float) -> TurbulenceConfig:
-    """Preset with the notes' anisotropy sigma_v = 0.8 sigma_u, sigma_w = 0.6 sigma_u."""
-    return TurbulenceConfig(sigma_u=sigma_u, sigma_v=round(0.8 * sigma_u, 6),
-                            sigma_w=round(0.6 * sigma_u, 6))
-
-
 PRESETS: dict[str, TurbulenceConfig] = {
-    "none": _preset(0.0),
-    "light": _preset(0.8),
-    "moderate": _preset(1.6),
-    "severe": _preset(2.4),
+    "none": TurbulenceConfig(),
+    **{name: TurbulenceConfig(intensity_model="mil", intensity=name)
+       for name in ("light", "moderate", "severe")},
 }
 
 
@@ -210,6 +327,14 @@ def _from_dict(d: dict) -> TurbulenceConfig:
     if unknown:
         raise ValueError(f"unknown turbulence field(s) {unknown}; known: {sorted(known)}")
     return base.replace(**d)
+
+
+def _explicit_sigmas(changes: dict) -> dict:
+    """``changes`` with intensity_model 'fixed' added when it sets a sigma but no model."""
+    if any(k in changes for k in ("sigma_u", "sigma_v", "sigma_w")) and \
+            "intensity_model" not in changes:
+        return {**changes, "intensity_model": "fixed"}
+    return changes
 
 
 def describe(cfg: TurbulenceConfig) -> list[dict]:

@@ -6,25 +6,38 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..analysis.trim import find_equilibrium
 from ..envs.spaces import CHANNELS, OBS_WIND_X, OBS_WIND_Y, OBS_WIND_Z
 from ..envs.vector import TetheredAerostatVectorEnv
-from ..params import load_params
+from ..params import apply_overrides, load_params
 from ..physics.core import rotation_matrix
 from ..sim import Model
-from .trim import find_equilibrium
 
-OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 80, 100)
+OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 75, 90)
 WIND = [OBS_WIND_X, OBS_WIND_Y, OBS_WIND_Z]  # measured air velocity at the CM
 
 
-def yaw_curve(stall_deg: float, wind_speed: float = 8.0) -> list[float]:
-    """Yaw acceleration dr/dt [rad/s^2] at the trim with psi offset by each of OFFSETS_DEG."""
-    p = load_params().replace(**{"fins.alpha_stall_deg": stall_deg})
+def yaw_curve(wind_speed: float = 8.0, overrides: dict | None = None,
+              offsets=OFFSETS_DEG, params=None) -> list[float]:
+    """Static yaw acceleration dr/dt [rad/s^2] at the trim with psi offset by each yaw offset.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Uniform wind speed [m/s] of the trim.
+    overrides : dict, optional
+        Parameter overrides (dotted keys, e.g. ``{"fins.post_stall": "flat"}``).
+    offsets : sequence of float
+        Yaw offsets from the trim heading [deg]; negative results restore.
+    params : Params, optional
+        The aerostat (default: the baseline); ``overrides`` apply to it.
+    """
+    p = apply_overrides(params or load_params(), overrides or {})
     eq = find_equilibrium(p, wind_speed)
     model = Model(p, wind=wind_speed)
     lay = model.layout
     out = []
-    for deg in OFFSETS_DEG:
+    for deg in offsets:
         x = eq.x.copy()
         x[lay.euler.start + 2] += np.radians(deg)
         out.append(float(model.rhs(x)[lay.rates.start + 2]))
@@ -38,10 +51,26 @@ def sideslip(euler: np.ndarray, v_rel: np.ndarray) -> np.ndarray:
     return np.degrees(np.arctan2(np.abs(body[:, 1]), body[:, 0]))
 
 
-def max_sideslip(turbulence: str, wind_speed: float, episodes: int) -> np.ndarray:
-    """Largest sideslip [deg] of each passive-winch episode (120 s, seeds 100, 101, ...)."""
+def max_sideslip(turbulence: str, wind_speed: float, episodes: int,
+                 overrides: dict | None = None, params=None) -> np.ndarray:
+    """Largest sideslip [deg] of each passive-winch episode (120 s, seeds 100, 101, ...).
+
+    Parameters
+    ----------
+    turbulence : str
+        The environment's turbulence (an intensity class or a config).
+    wind_speed : float
+        Episode wind speed [m/s].
+    episodes : int
+        Number of episodes.
+    overrides : dict, optional
+        Parameter overrides (dotted keys, e.g. ``{"aerostat.air_inertia": False}``).
+    params : Params, optional
+        The aerostat (default: the baseline).
+    """
     env = TetheredAerostatVectorEnv(num_envs=episodes, max_episode_steps=600, observation="full",
-                                    turbulence=turbulence, perturbation="none")
+                                    turbulence=turbulence, perturbation="none", params=params,
+                                    overrides=overrides)
     obs, _ = env.reset(seed=list(range(100, 100 + episodes)),
                        options={"wind_speed": [wind_speed] * episodes})
     b, lay = env.batch, env.batch.layout

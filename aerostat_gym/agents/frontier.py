@@ -1,0 +1,321 @@
+"""Swing-recovery runs of winch policies in the environment, and the damping-versus-reel-speed
+frontier (pendulum damping ratio against the peak reel set-point a swing asks for).
+
+One run (:func:`swing_response`): ``TetheredAerostat-v0`` in steady wind (no turbulence), the
+aerostat and tether swung rigidly about the winch by ``swing`` metres along the wind (fixed, not
+drawn, no pitch kick), the policy in the loop at the 0.2 s control step for ``duration``
+seconds. The pendulum damping ratio is fitted to the along-wind CM displacement
+(:func:`aerostat_gym.agents.metrics.fit_damped_sinusoid`); the peak reel speed and the peak
+set-point come from the winch state and the action.
+
+Brake logic. The shipped winch engages its brake whenever |v_set| < winch.brake_speed
+(0.02 m/s), which swallows the small commands of a linear controller near the end of a swing
+(and all of them at a 0.5-1 m swing). ``brake_speed=0`` turns this dead band off, which is what
+a dwell-time brake (:func:`aerostat_gym.winch_dwell.dwell_brake_rule`: engage only after the
+command has stayed near zero for a dwell time) does for a controller whose command keeps
+moving. :func:`swing_response_dwell` runs the dwell-time rule itself, through
+:func:`aerostat_gym.simulation.simulate` (the environment's compiled step still applies the
+shipped rule), for policies that read the privileged full observation.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
+from ..envs.vector import TetheredAerostatVectorEnv
+from ..params import apply_overrides, load_params
+from ..sim import simulate
+from ..sim.winch_dwell import DEFAULT_DWELL_TIME, DEFAULT_STANDSTILL_BAND, DwellBrake
+from .evaluate import policy_obs
+from .metrics import fit_damped_sinusoid
+from .metrics_drift import fit_pendulum_with_drift
+from .modal import design_modal
+
+
+@dataclass
+class SwingRun:
+    """Histories and figures of one swing-recovery run.
+
+    Attributes
+    ----------
+    wind_speed : float
+        Mean wind speed [m/s].
+    swing : float
+        Initial along-wind swing [m].
+    time : numpy.ndarray
+        Sample times [s] (control steps).
+    x : numpy.ndarray
+        Along-wind CM displacement from trim [m].
+    length : numpy.ndarray
+        Paid-out length minus trim [m].
+    reel_speed : numpy.ndarray
+        Winch reel speed v_w [m/s].
+    set_point : numpy.ndarray
+        Commanded set-point, action times max_speed [m/s] (one per step).
+    zeta : float
+        Pendulum damping ratio fitted to ``x``.
+    period : float
+        Natural period of that fit [s].
+    r2 : float
+        Coefficient of determination of that fit.
+    ended : str or None
+        Termination reason, None for a full run.
+    zeta_drift : float
+        Pendulum damping ratio of the sinusoid-plus-drift fit
+        (:func:`aerostat_gym.agents.metrics_drift.fit_pendulum_with_drift`).
+    """
+
+    wind_speed: float
+    swing: float
+    time: np.ndarray
+    x: np.ndarray
+    length: np.ndarray
+    reel_speed: np.ndarray
+    set_point: np.ndarray
+    zeta: float
+    period: float
+    r2: float
+    ended: str | None
+    zeta_drift: float = math.nan
+
+    @property
+    def peak_reel_speed(self) -> float:
+        return float(np.max(np.abs(self.reel_speed)))
+
+    @property
+    def peak_set_point(self) -> float:
+        return float(np.max(np.abs(self.set_point)))
+
+    @property
+    def length_wander(self) -> float:
+        """Largest |L - L_trim| over the run [m]."""
+        return float(np.max(np.abs(self.length)))
+
+    def row(self) -> dict:
+        return {"wind_speed": self.wind_speed, "swing_m": self.swing, "zeta": self.zeta,
+                "zeta_drift": self.zeta_drift,
+                "period_s": self.period, "fit_r2": self.r2,
+                "peak_reel_speed_m_s": self.peak_reel_speed,
+                "peak_set_point_m_s": self.peak_set_point,
+                "length_wander_m": self.length_wander, "ended": self.ended}
+
+
+def swing_env(wind_speed: float, swing: float, brake_speed: float | None = None,
+              obs_noise: float = 0.0, params=None, control_step: float = 0.2,
+              duration: float = 180.0, num_envs: int = 1) -> TetheredAerostatVectorEnv:
+    """The vector environment of a swing-recovery run (full observation, steady wind)."""
+    overrides = None if brake_speed is None else {"winch.brake_speed": float(brake_speed)}
+    return TetheredAerostatVectorEnv(
+        num_envs=num_envs, max_episode_steps=int(round(duration / control_step)),
+        observation="full", control_step=control_step, turbulence="none",
+        wind_speed=(wind_speed, wind_speed), params=params, overrides=overrides,
+        obs_noise=obs_noise,
+        perturbation={"swing": float(swing), "lateral": 0.0, "pitch": 0.0, "fixed": True})
+
+
+def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: float | None = None,
+                   obs_noise: float = 0.0, seed: int = 0, params=None, duration: float = 180.0,
+                   control_step: float = 0.2) -> SwingRun:
+    """Run ``policy`` through one swing recovery and fit its pendulum damping.
+
+    Parameters
+    ----------
+    policy : object
+        Anything with SB3's ``predict(observation, state, episode_start, deterministic)``.
+    wind_speed : float
+        Mean wind speed [m/s].
+    swing : float
+        Initial along-wind swing of aerostat and tether [m].
+    brake_speed : float or None
+        Override of winch.brake_speed (None: the shipped 0.02 m/s dead band; 0: off).
+    obs_noise : float
+        Sensor noise std in the environment's scaled units.
+    seed : int
+        Reset seed (draws the sensor noise).
+    params : Params or None
+        Environment parameters (default: the shipped baseline).
+    duration : float
+        Length of the run [s].
+    control_step : float
+        Control step [s].
+
+    Returns
+    -------
+    SwingRun
+    """
+    if not (math.isfinite(swing) and swing > 0):
+        raise ValueError(f"swing must be finite and > 0 [m], got {swing!r}")
+    env = swing_env(wind_speed, swing, brake_speed, obs_noise, params, control_step, duration)
+    obs, _ = env.reset(seed=[seed], options={"wind_speed": [wind_speed]})
+    b, lay = env.batch, env.batch.layout
+    vmax = float(b.params.winch.max_speed)
+    ix, iL, iv = lay.cm_pos.start, lay.winch_length, lay.winch_speed
+    steps = env.max_episode_steps
+    x, L, v, sp = (np.zeros(steps + 1) for _ in range(4))
+    x[0], L[0], v[0] = (b.state[0, ix] - b.trim_state[0, ix], b.state[0, iL] - b.trim_state[0, iL], b.state[0, iv])
+    state, start, ended, k_end = None, np.ones(1, bool), None, steps
+    for k in range(1, steps + 1):
+        action, state = policy.predict(policy_obs(policy, obs), state=state, episode_start=start,
+                                       deterministic=True)
+        start[:] = False
+        a = np.asarray(action, np.float32).reshape(-1, 1)
+        sp[k - 1] = float(np.clip(a[0, 0], -1.0, 1.0)) * vmax
+        obs, _, term, trunc, info = env.step(a)
+        x[k], L[k], v[k] = (b.state[0, ix] - b.trim_state[0, ix], b.state[0, iL] - b.trim_state[0, iL], b.state[0, iv])
+        if term[0]:
+            ended, k_end = str(info["termination"][0]), k
+            break
+    env.close()
+    t = np.arange(k_end + 1) * control_step
+    fit = fit_damped_sinusoid(t, x[:k_end + 1])
+    drift = fit_pendulum_with_drift(t, x[:k_end + 1])
+    return SwingRun(float(wind_speed), float(swing), t, x[:k_end + 1], L[:k_end + 1],
+                    v[:k_end + 1], sp[:k_end], fit.zeta, fit.period, fit.r2, ended, drift.zeta)
+
+
+def initial_state(wind_speed: float, swing: float, params=None) -> tuple[np.ndarray, np.ndarray]:
+    """(x0, x_trim): the environment's start of a swing-recovery run and its trim (6n+8)."""
+    env = swing_env(wind_speed, swing, params=params)
+    env.reset(seed=[0], options={"wind_speed": [wind_speed]})
+    x0, xt = env.batch.state[0].copy(), env.batch.trim_state[0].copy()
+    env.close()
+    return x0, xt
+
+
+def initial_deviation(wind_speed: float, swing: float, params=None) -> np.ndarray:
+    """The environment's start of a swing-recovery run as a deviation from trim (6n+8)."""
+    x0, xt = initial_state(wind_speed, swing, params)
+    return x0 - xt
+
+
+def swing_response_dwell(policy, wind_speed: float, swing: float, *,
+                         dwell: float = DEFAULT_DWELL_TIME,
+                         band: float = DEFAULT_STANDSTILL_BAND,
+                         params=None, duration: float = 180.0,
+                         control_step: float = 0.2) -> SwingRun:
+    """:func:`swing_response` with the dwell-time brake logic, for a full-observation policy.
+
+    Parameters
+    ----------
+    policy : object
+        A policy reading the privileged full observation (wind speed at index 19, x - x_trim
+        from index 20), e.g. :class:`~aerostat_gym.agents.lqr.LQRPolicy`.
+    wind_speed : float
+        Mean wind speed [m/s].
+    swing : float
+        Initial along-wind swing [m].
+    dwell : float
+        Stand-still time before the brake is applied [s].
+    band : float
+        Stand-still band of the set-point [m/s] (default 0.002, the proposal).
+    params : Params or None
+        Parameters (default: the shipped baseline).
+    duration : float
+        Length of the run [s].
+    control_step : float
+        Control step [s] (the policy's and the winch logic's rate).
+
+    Returns
+    -------
+    SwingRun
+        With the semi-implicit integrator, as the environment uses.
+    """
+    params = params or load_params()
+    x0, xt = initial_state(wind_speed, swing, params)
+    brake = DwellBrake(band, control_step, dwell)
+    vmax = float(params.winch.max_speed)
+    lay_size = x0.size
+    n = (lay_size - 8) // 6
+    o = 6 * (n - 1)  # first aerostat entry of the layout (CM position)
+    i_psi = o + 8
+    memo = {"state": None, "start": np.ones(1, bool), "sp": []}
+
+    def u(t, x):
+        dx = x - xt
+        dx[i_psi] = (dx[i_psi] + np.pi) % (2.0 * np.pi) - np.pi
+        obs = np.zeros(OBS_FULL_STATE + lay_size)
+        obs[OBS_FULL_WIND], obs[OBS_FULL_STATE:] = wind_speed, dx
+        a, memo["state"] = policy.predict(obs, memo["state"], memo["start"])
+        memo["start"][:] = False
+        v = float(np.clip(a[0], -1.0, 1.0)) * vmax
+        memo["sp"].append(v)
+        return brake(v)
+
+    tr = simulate(apply_overrides(params, {"winch.brake_speed": 0.0}), x0, duration,
+                  wind=wind_speed, integrator="semi-implicit", output_dt=control_step, u=u)
+    x = tr.cm_pos[:, 0] - xt[o]
+    fit = fit_damped_sinusoid(tr.time, x)
+    drift = fit_pendulum_with_drift(tr.time, x)
+    return SwingRun(float(wind_speed), float(swing), tr.time, x, tr.length - xt[o + 12],
+                    tr.reel_speed, np.array(memo["sp"]), fit.zeta, fit.period, fit.r2,
+                    None if tr.status == "ok" else tr.status, drift.zeta)
+
+
+def linear_response(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, steps: int
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """(states, set-points) of the discrete closed loop x_{k+1} = Acl x_k, v_k = -K x_k."""
+    X = np.empty((steps + 1, dx0.size))
+    X[0] = dx0
+    for k in range(steps):
+        X[k + 1] = Acl @ X[k]
+    return X, -(X[:-1] @ K)
+
+
+def modal_linear_peak(design, dx0_full: np.ndarray, duration: float = 180.0) -> float:
+    """Peak |v_set| [m/s] the linear closed loop of a :class:`~aerostat_gym.agents.modal.
+    ModalDesign` asks for from the start ``dx0_full`` (full layout; the subset is used)."""
+    steps = int(round(duration / design.dt))
+    _, v = linear_response(design.closed_loop_matrix, design.K_subset,
+                           dx0_full[design.index], steps)
+    return float(np.max(np.abs(v)))
+
+
+def linear_fit_zeta(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, i_x: int,
+                    duration: float = 180.0, dt: float = 0.2) -> tuple[float, float]:
+    """Pendulum damping ratios that :func:`fit_damped_sinusoid` and
+    :func:`~aerostat_gym.agents.metrics_drift.fit_pendulum_with_drift` find in the linear
+    closed loop's along-wind CM displacement (state ``i_x`` of ``dx0``'s layout) from ``dx0``.
+
+    Notes
+    -----
+    This is the like-for-like linear value for a nonlinear run's fitted damping: the
+    single-mode fit is biased low where the pendulum is well damped and other slow modes (the
+    length loop, the LQR's integral) share the record, by 0.6 % (LQR, 5 m/s), 6 % (LQR,
+    10 m/s), 22 % (LQR, 15 m/s) and 5-12 % (modal at 10-15 m/s) against the eigenvalue.
+    """
+    steps = int(round(duration / dt))
+    X, _ = linear_response(Acl, K, dx0, steps)
+    t = np.arange(steps + 1) * dt
+    return (fit_damped_sinusoid(t, X[:, i_x]).zeta,
+            fit_pendulum_with_drift(t, X[:, i_x]).zeta)
+
+
+def modal_peak_limit(params, wind_speed: float, swing: float, peak: float = 1.0,
+                     tol: float = 1e-3, dt: float = 0.2) -> tuple[float, float]:
+    """(zeta, peak set-point): the largest modal pendulum damping whose linear closed loop asks
+    for at most ``peak`` [m/s] from a ``swing`` [m] along-wind start, by bisection on zeta
+    between the open-loop value and 0.99 (the peak set-point grows with zeta).
+
+    This is the modal controller's own frontier end at the winch's speed limit, not a bound
+    over every controller.
+    """
+    dx0 = initial_deviation(wind_speed, swing, params)
+    first = design_modal(params, wind_speed, 0.5, dt)
+    lo = float(first.lqr.mode("pendulum", "open").zeta) + 1e-3
+    hi = 0.99
+
+    def peak_at(z):
+        return modal_linear_peak(design_modal(params, wind_speed, z, dt, lqr=first.lqr), dx0)
+
+    if peak_at(lo) > peak:
+        return lo, peak_at(lo)
+    if peak_at(hi) <= peak:
+        return hi, peak_at(hi)
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if peak_at(mid) <= peak else (lo, mid)
+    return lo, peak_at(lo)

@@ -1,0 +1,391 @@
+"""Output-feedback LQG winch controller: a steady-state Kalman filter on the standard observation
+channels (the ones a learned policy sees, with the environment's sensor noise) and the
+gain-scheduled LQR gains acting on the estimate.
+
+Design at one mean wind speed U (:func:`design_lqg`):
+
+1. the LQR of :func:`aerostat_gym.agents.lqr.design_lqr` on the longitudinal + winch subset
+   (``subset="long"``: the lateral states are uncontrollable from the winch and get no gain), with
+   its integral of the length error;
+2. the same subset's zero-order-hold model x_{k+1} = Ad x_k + Bd u_k + w_k (u the set-point);
+3. measurements y = C x + v from the standard observation (:data:`MEASURED`): CM displacement
+   and velocity along the wind and up, pitch, pitch rate, winch tension minus trim (its row is
+   the finite-difference gradient of the compiled winch-end tension), paid-out length and reel
+   speed, each in SI units (channel value times its scale);
+4. measurement noise R = diag((sigma scale_k)^2): the environment adds Gaussian noise of std
+   ``obs_noise`` in scaled units to every standard channel, so sigma is that ``obs_noise``
+   (floored at :data:`MIN_NOISE` so that R stays positive definite for a noise-free env);
+5. process noise W = diag(q_i^2) from :data:`DEFAULT_PROCESS_NOISE`: the per-step random change
+   of each state that the turbulence and the unmodelled nonlinearity cause (largest on the
+   velocities, where the gust forces enter);
+6. the filter Riccati equation (the dual DARE, :func:`scipy.linalg.solve_discrete_are` on
+   (Ad^T, C^T)) gives the a-priori covariance P and the gain L = P C^T (C P C^T + R)^-1.
+
+Filter, once per control step: predict x- = Ad x^ + Bd u_prev, correct x^ = x- + L (y - C x-).
+The estimation error e = x - x^ then obeys e_k = (I - L C) Ad e_{k-1} + noise terms, so without
+noise it decays with the eigenvalues of (I - L C) Ad: the designed estimator rate
+(:attr:`LQGDesign.estimator_poles`). By the separation principle the closed loop's poles are the
+LQR's and the estimator's, so its linear pendulum damping is the LQR's.
+
+The schedule interpolates every matrix linearly in U, and U itself is estimated from the
+measured along-wind air velocity at the aerostat (channel 16), low-passed with time constant
+:data:`WIND_TIME_CONSTANT`: no privileged information reaches the policy.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..analysis.linear import state_steps
+from ..analysis.trim import find_equilibrium
+from ..envs.spaces import CHANNELS, N_OBS
+from ..params import Params
+from ..physics.state import StateLayout
+from ..sim import Model
+from .lqr import DEFAULT_SPEEDS, LQRDesign, design_lqr, discretize
+
+#: Standard observation channels the filter uses (name -> index), all longitudinal.
+MEASURED = {"dx": 0, "dz": 2, "vx": 3, "vz": 5, "dpitch": 7, "q": 10, "dtension": 13,
+            "dlength": 14, "reel_speed": 15}
+#: Channel of the measured along-wind air velocity (the wind-speed estimate for the schedule).
+WIND_CHANNEL = 16
+#: Time constant of the wind-speed estimate [s].
+WIND_TIME_CONSTANT = 20.0
+#: Sensor noise the filter is designed for when the environment's obs_noise is 0 (scaled units).
+MIN_NOISE = 1.0e-3
+#: Per-step process-noise standard deviation of each state group (SI units).
+DEFAULT_PROCESS_NOISE = {
+    "node_pos": 0.01,  # m
+    "node_vel": 0.05,  # m/s, gust drag on the tether
+    "cm_pos": 0.01,  # m
+    "cm_vel": 0.05,  # m/s, gust forces on the hull
+    "pitch": 1.0e-3,  # rad
+    "pitch_rate": 5.0e-3,  # rad/s, gust moments
+    "length": 1.0e-3,  # m (1e-4 leaves the neutral length estimate a 48 s time constant)
+    "reel_speed": 1.0e-3,  # m/s
+}
+
+
+def _process_noise(layout: StateLayout, idx: np.ndarray, noise: dict) -> np.ndarray:
+    """W = diag(q^2) over the subset ``idx`` (full-layout indices)."""
+    unknown = sorted(set(noise) - set(DEFAULT_PROCESS_NOISE))
+    if unknown:
+        raise ValueError(f"unknown process-noise group(s) {unknown}; known: "
+                         f"{list(DEFAULT_PROCESS_NOISE)}")
+    q = {**DEFAULT_PROCESS_NOISE, **noise}
+    for k, v in q.items():
+        if not (isinstance(v, float | int) and math.isfinite(v) and v > 0):
+            raise ValueError(f"process noise {k!r} must be finite and > 0, got {v!r}")
+    s = np.zeros(layout.size)
+    s[layout.node_pos] = q["node_pos"]
+    s[layout.node_vel] = q["node_vel"]
+    s[layout.cm_pos] = q["cm_pos"]
+    s[layout.cm_vel] = q["cm_vel"]
+    s[layout.euler] = q["pitch"]
+    s[layout.rates] = q["pitch_rate"]
+    s[layout.winch_length] = q["length"]
+    s[layout.winch_speed] = q["reel_speed"]
+    return np.diag(s[idx] ** 2)
+
+
+def tension_gradient(params: Params, x_trim: np.ndarray, wind_speed: float, idx: np.ndarray,
+                     eps: float = 1e-5) -> np.ndarray:
+    """d T_winch / d x over the subset ``idx`` by central differences of the compiled
+    winch-end tension (steps of :func:`aerostat_gym.analysis.linear.state_steps`)."""
+    model = Model(params, wind=wind_speed)
+    h = state_steps(x_trim, eps)
+    g = np.empty(idx.size)
+    for k, j in enumerate(idx):
+        xp, xm = x_trim.copy(), x_trim.copy()
+        xp[j] += h[j]
+        xm[j] -= h[j]
+        g[k] = (model.end_tensions(xp)[1] - model.end_tensions(xm)[1]) / (2.0 * h[j])
+    return g
+
+
+def measurement_matrix(params: Params, lqr: LQRDesign, idx: np.ndarray) -> np.ndarray:
+    """C (len(MEASURED), len(idx)): SI measurements as linear functions of the subset state."""
+    lay = lqr.linear.layout
+    pos = {j: k for k, j in enumerate(idx)}
+    direct = {"dx": lay.cm_pos.start, "dz": lay.cm_pos.start + 2, "vx": lay.cm_vel.start,
+              "vz": lay.cm_vel.start + 2, "dpitch": lay.euler.start + 1,
+              "q": lay.rates.start + 1, "dlength": lay.winch_length,
+              "reel_speed": lay.winch_speed}
+    C = np.zeros((len(MEASURED), idx.size))
+    for r, name in enumerate(MEASURED):
+        if name == "dtension":
+            C[r] = tension_gradient(params, lqr.x_trim, lqr.wind_speed, idx)
+        else:
+            C[r, pos[direct[name]]] = 1.0
+    return C
+
+
+def measurement_noise(obs_noise: float) -> np.ndarray:
+    """R = diag((sigma scale_k)^2) for the measured channels, sigma = max(obs_noise,
+    MIN_NOISE) in the environment's scaled units."""
+    if not (isinstance(obs_noise, float | int) and math.isfinite(obs_noise) and obs_noise >= 0):
+        raise ValueError(f"obs_noise must be a finite number >= 0, got {obs_noise!r}")
+    sigma = max(float(obs_noise), MIN_NOISE)
+    return np.diag([(sigma * CHANNELS[i].scale) ** 2 for i in MEASURED.values()])
+
+
+def kalman_gain(Ad: np.ndarray, C: np.ndarray, W: np.ndarray, R: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """(P, L): a-priori steady-state covariance from the filter DARE and the correction gain
+    L = P C^T (C P C^T + R)^-1."""
+    P = sla.solve_discrete_are(Ad.T, C.T, W, R)
+    P = 0.5 * (P + P.T)
+    L = np.linalg.solve(C @ P @ C.T + R, C @ P).T
+    return P, L
+
+
+@dataclass
+class LQGDesign:
+    """One LQG design at mean wind speed ``wind_speed`` (subset: longitudinal + L, v_w).
+
+    Attributes
+    ----------
+    lqr : LQRDesign
+        The state-feedback design (subset "long").
+    index : numpy.ndarray
+        Full-layout indices of the subset.
+    Ad : numpy.ndarray
+        Discrete open-loop matrix of the subset.
+    Bd : numpy.ndarray
+        Discrete input column of the subset, (n, 1).
+    C : numpy.ndarray
+        Measurement matrix (SI units).
+    R : numpy.ndarray
+        Measurement-noise covariance.
+    W : numpy.ndarray
+        Process-noise covariance.
+    P : numpy.ndarray
+        A-priori steady-state error covariance.
+    L : numpy.ndarray
+        Correction gain.
+    K : numpy.ndarray
+        State gain over the subset.
+    K_integral : float
+        Gain on the integral of the length error.
+    obs_noise : float
+        Sensor noise (scaled units) the filter was designed for.
+    """
+
+    lqr: LQRDesign = field(repr=False)
+    index: np.ndarray
+    Ad: np.ndarray
+    Bd: np.ndarray
+    C: np.ndarray
+    R: np.ndarray
+    W: np.ndarray
+    P: np.ndarray
+    L: np.ndarray
+    K: np.ndarray
+    K_integral: float
+    obs_noise: float
+
+    @property
+    def wind_speed(self) -> float:
+        return self.lqr.wind_speed
+
+    @property
+    def error_matrix(self) -> np.ndarray:
+        """(I - L C) Ad: one step of the noise-free estimation error."""
+        return (np.eye(self.Ad.shape[0]) - self.L @ self.C) @ self.Ad
+
+    @property
+    def estimator_poles(self) -> np.ndarray:
+        """Discrete eigenvalues of the estimation error dynamics."""
+        return np.linalg.eigvals(self.error_matrix)
+
+    def summary(self) -> dict:
+        """The LQR's predicted modes (separation principle: the LQG's closed-loop pendulum,
+        pitching and axial-spring modes are the LQR's), plus the slowest estimator pole."""
+        z = self.estimator_poles
+        zmax = z[np.argmax(np.abs(z))]
+        s = np.log(complex(zmax)) / self.lqr.dt
+        return {**self.lqr.summary(),
+                "estimator": {"spectral_radius": float(abs(zmax)),
+                              "slowest_time_constant_s": float(-1.0 / s.real)}}
+
+
+def design_lqg(params: Params, wind_speed: float, dt: float = 0.2, obs_noise: float = 0.0, *,
+               process_noise: dict | None = None, weights: dict | None = None,
+               equilibrium=None) -> LQGDesign:
+    """Kalman filter + LQR at one wind speed (see the module docstring).
+
+    Parameters
+    ----------
+    params : Params
+        Model parameters.
+    wind_speed : float
+        Trim wind speed [m/s].
+    dt : float
+        Control step [s].
+    obs_noise : float
+        The environment's sensor noise std in its scaled units.
+    process_noise : dict or None
+        Overrides of :data:`DEFAULT_PROCESS_NOISE`.
+    weights : dict or None
+        LQR weight overrides (:data:`aerostat_gym.agents.lqr.DEFAULT_WEIGHTS`).
+    equilibrium : Equilibrium or None
+        A trim at ``wind_speed`` to reuse.
+
+    Returns
+    -------
+    LQGDesign
+    """
+    eq = equilibrium or find_equilibrium(params, float(wind_speed))
+    lqr = design_lqr(params, float(wind_speed), dt, weights, equilibrium=eq, subset="long")
+    idx = lqr.mode_index[:-1]
+    Ad, Bd = discretize(lqr.linear.A_free[np.ix_(idx, idx)], lqr.linear.B[idx], dt)
+    C = measurement_matrix(params, lqr, idx)
+    R = measurement_noise(obs_noise)
+    W = _process_noise(lqr.linear.layout, idx, process_noise or {})
+    P, L = kalman_gain(Ad, C, W, R)
+    return LQGDesign(lqr=lqr, index=idx, Ad=Ad, Bd=Bd, C=C, R=R, W=W, P=P, L=L,
+                     K=lqr.K[idx].copy(), K_integral=lqr.K_integral, obs_noise=float(obs_noise))
+
+
+class LQGSchedule:
+    """LQG designs over mean wind speed; every matrix interpolated linearly in U (clamped).
+
+    Parameters
+    ----------
+    params : Params
+        Model parameters.
+    speeds : array_like or None
+        Design speeds [m/s], increasing (default 2 to 16 m/s in 1 m/s steps).
+    dt : float
+        Control step [s].
+    obs_noise : float
+        Sensor noise the filters are designed for (scaled units).
+    process_noise : dict or None
+        Overrides of :data:`DEFAULT_PROCESS_NOISE`.
+    """
+
+    def __init__(self, params: Params, speeds=None, dt: float = 0.2, obs_noise: float = 0.0,
+                 process_noise: dict | None = None):
+        speeds = np.asarray(DEFAULT_SPEEDS if speeds is None else speeds, float).ravel()
+        if speeds.size == 0 or np.any(np.diff(speeds) <= 0) or np.any(speeds < 0):
+            raise ValueError(f"speeds must be non-negative and strictly increasing, got {speeds}")
+        designs, eq = [], None
+        for U in speeds:
+            eq = find_equilibrium(params, float(U), guess=eq)
+            designs.append(design_lqg(params, float(U), dt, obs_noise,
+                                      process_noise=process_noise, equilibrium=eq))
+        self.params, self.speeds, self.dt, self.designs = params, speeds, float(dt), designs
+        self.index = designs[0].index
+        self.tables = {name: np.array([getattr(d, name) for d in designs])
+                       for name in ("Ad", "Bd", "C", "L", "K")}
+        self.tables["K_integral"] = np.array([d.K_integral for d in designs])
+
+    def lookup(self, U: np.ndarray) -> dict:
+        """Every table at the speeds U (N,), linear in U between the design speeds."""
+        s = self.speeds
+        U = np.asarray(U, float)
+        if s.size == 1:
+            return {k: np.broadcast_to(v[0], U.shape + v.shape[1:]) for k, v in self.tables.items()}
+        Uc = np.clip(U, s[0], s[-1])
+        i = np.clip(np.searchsorted(s, Uc, side="right") - 1, 0, s.size - 2)
+        w = (Uc - s[i]) / (s[i + 1] - s[i])
+        out = {}
+        for k, v in self.tables.items():
+            ww = w.reshape(w.shape + (1,) * (v.ndim - 1))
+            out[k] = (1.0 - ww) * v[i] + ww * v[i + 1]
+        return out
+
+
+class LQGPolicy:
+    """The LQG as an SB3-style policy on the standard 19-channel observation.
+
+    Parameters
+    ----------
+    params : Params
+        Parameters of the environment.
+    dt : float
+        Control step [s] (must match the schedule's).
+    obs_noise : float
+        The environment's sensor noise (scaled units); designs the filters.
+    schedule : LQGSchedule or None
+        The design table (default: built here over 2-16 m/s).
+
+    Notes
+    -----
+    ``state`` is an (N, n + 3) array per environment: the estimate x^ (n subset states), the
+    length-error integral z, the wind-speed estimate and the last set-point sent. On
+    ``episode_start`` the estimate restarts from x- = 0 (the trim) corrected by the first
+    measurement, the integral from 0 and the wind estimate from the first air-velocity reading.
+    The integral is conditional (no integration while saturated in the direction it pushes),
+    as in :class:`aerostat_gym.agents.lqr.LQRPolicy`.
+    """
+
+    obs_dim = N_OBS
+
+    def __init__(self, params: Params, dt: float = 0.2, obs_noise: float = 0.0,
+                 schedule: LQGSchedule | None = None):
+        self.params = params
+        self.dt = float(dt)
+        self.schedule = schedule or LQGSchedule(params, dt=dt, obs_noise=obs_noise)
+        if abs(self.schedule.dt - self.dt) > 1e-12:
+            raise ValueError(f"schedule was designed for dt = {self.schedule.dt} s, policy "
+                             f"dt = {self.dt} s")
+        self.max_speed = float(params.winch.max_speed)
+        self.n = self.schedule.index.size
+        self.scale = np.array([CHANNELS[i].scale for i in MEASURED.values()])
+        self.channels = np.array(list(MEASURED.values()))
+        self.i_length = list(MEASURED).index("dlength")
+
+    def _state(self, state, N: int) -> np.ndarray:
+        if state is None:
+            return np.full((N, self.n + 3), np.nan)
+        S = np.array(state, dtype=float).reshape(N, -1)
+        if S.shape != (N, self.n + 3):
+            raise ValueError(f"LQG state must have shape ({N}, {self.n + 3}), got "
+                             f"{np.shape(state)}")
+        return S
+
+    def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
+        """(actions, state): actions (1,) or (N, 1) float32 in [-1, 1]; state to pass back."""
+        obs = np.asarray(observation, dtype=float)
+        single = obs.ndim == 1
+        obs2 = obs[None, :] if single else obs
+        if obs2.ndim != 2 or obs2.shape[1] < N_OBS:
+            raise ValueError(f"LQGPolicy needs the standard observation ({N_OBS} channels), got "
+                             f"shape {obs.shape}")
+        N = obs2.shape[0]
+        S = self._state(state, N)
+        start = np.isnan(S[:, 0])
+        if episode_start is not None:
+            start |= np.broadcast_to(np.asarray(episode_start, bool).reshape(-1), (N,))
+        wind = obs2[:, WIND_CHANNEL] * CHANNELS[WIND_CHANNEL].scale
+        S[start] = 0.0
+        S[start, self.n + 1] = wind[start]
+        U = S[:, self.n + 1] + (self.dt / WIND_TIME_CONSTANT) * (wind - S[:, self.n + 1])
+        U[start] = wind[start]
+        m = self.schedule.lookup(U)
+        y = obs2[:, self.channels] * self.scale
+        x_pred = np.einsum("nij,nj->ni", m["Ad"], S[:, :self.n]) + m["Bd"][..., 0] * S[:, -1:]
+        x_pred[start] = 0.0
+        innov = y - np.einsum("nij,nj->ni", m["C"], x_pred)
+        x_hat = x_pred + np.einsum("nij,nj->ni", m["L"], innov)
+        z = S[:, self.n]
+        kz = m["K_integral"]
+        v = -np.einsum("ni,ni->n", m["K"], x_hat) - kz * z
+        v_cmd = np.clip(v, -self.max_speed, self.max_speed)
+        dz = self.dt * y[:, self.i_length]
+        push = -kz * dz
+        wind_up = ((v >= self.max_speed) & (push > 0)) | ((v <= -self.max_speed) & (push < 0))
+        S_next = np.column_stack([x_hat, np.where(wind_up, z, z + dz), U, v_cmd])
+        actions = np.clip(v_cmd / self.max_speed, -1.0, 1.0).astype(np.float32)[:, None]
+        return (actions[0] if single else actions), S_next
+
+    def predicted_modes(self, wind_speed: float) -> dict:
+        """The design nearest ``wind_speed``: LQR modes and the slowest estimator pole."""
+        k = int(np.argmin(np.abs(self.schedule.speeds - wind_speed)))
+        return {"design_wind_speed": float(self.schedule.speeds[k]),
+                **self.schedule.designs[k].summary()}

@@ -1,0 +1,169 @@
+"""Command-line front end of the Ray integration: ``tune`` and ``montecarlo``.
+
+The main CLI calls :func:`add_tune_parser` and :func:`add_montecarlo_parser`. Handlers return
+an exit status; bad input raises ValueError and a missing extra raises
+:class:`~aerostat_gym.scale.extra.MissingExtraError` (a RuntimeError), both of which the main
+CLI prints as one line and turns into exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+# the stability commands' parsing of --wind, --config and --set, shared rather than copied
+from ..scale.bench import format_throughput, throughput
+from ..scale.mc_report import summarize, write_outputs
+from ..scale.montecarlo import PERIOD_KEYS, SWEEP_SPEEDS, evaluate_sample, run_ray, run_serial
+from ..scale.ranges import RANGE_SOURCES, estimated_ranges
+from ..scale.tune import add_tune_arguments, run_tune_command
+from .stability import parse_speeds
+from .stability import stability_params as params_from_args
+
+
+def add_montecarlo_parser(sub) -> None:
+    """Register ``aerostat-gym montecarlo``.
+
+    Parameters
+    ----------
+    sub : the main parser's subparsers object.
+    """
+    p = sub.add_parser("montecarlo", help="Monte Carlo stability study over the estimated "
+                       "parameters (Ray tasks, or --serial)")
+    p.add_argument("--samples", type=int, default=100, help="parameter sets (default 100)")
+    p.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
+    p.add_argument("--serial", action="store_true", help="run in this process, without Ray")
+    p.add_argument("--address", help="join this Ray cluster (e.g. auto, HOST:6379, "
+                   "ray://HOST:10001) instead of starting a local one")
+    p.add_argument("--workers", type=int, help="CPUs of the local Ray instance (default: all)")
+    p.add_argument("--batch-size", type=int, help="parameter sets per Ray task")
+    p.add_argument("--wind", help="wind speeds START:STOP[:STEP] [m/s] (default 0.5:20:0.5, "
+                   "the Figure 9 grid without U = 0)")
+    p.add_argument("--ranges", choices=RANGE_SOURCES, default="documented",
+                   help="documented plausible ranges (sensitivity table, default) or the "
+                   "domain-randomisation half-ranges")
+    p.add_argument("--config", help="base parameter TOML (default: the shipped baseline)")
+    p.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                   help="override one base parameter (repeatable)")
+    p.add_argument("--out", help="output directory (default runs/montecarlo/seedS_nN)")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--no-plot", action="store_true", help="skip the figure")
+    p.add_argument("--bench", action="store_true", help="measure serial vs Ray throughput "
+                   "and Ray start-up on --samples sets, print them, write nothing else")
+    p.add_argument("--repeats", type=int, default=3, help="--bench: alternated serial and "
+                   "Ray runs (default 3)")
+    p.set_defaults(func=montecarlo_command)
+
+
+def add_tune_parser(sub) -> None:
+    """Register ``aerostat-gym tune``.
+
+    Parameters
+    ----------
+    sub : the main parser's subparsers object.
+    """
+    p = sub.add_parser("tune", help="Ray Tune: multi-seed hyperparameter search with the "
+                       "project's training function")
+    add_tune_arguments(p)
+    p.set_defaults(func=run_tune_command)
+
+
+def _speeds(text: str | None) -> np.ndarray:
+    return np.asarray(SWEEP_SPEEDS, float) if text is None else parse_speeds(text)
+
+
+def _progress(done: int, n: int) -> None:
+    if done == n or done % max(1, n // 20) == 0:
+        print(f"  {done}/{n} parameter sets", file=sys.stderr, flush=True)
+
+
+def montecarlo_command(args: argparse.Namespace) -> int:
+    """Run the study (or its throughput benchmark) and print the summary."""
+    base = params_from_args(args)
+    ranges = estimated_ranges(base, args.ranges)
+    speeds = _speeds(args.wind)
+    if args.bench:
+        res = throughput(base, ranges, args.samples, args.seed, speeds, args.workers or 2,
+                         args.batch_size, args.repeats)
+        print(json.dumps(res, indent=2) if args.json else format_throughput(res))
+        return 0
+    if args.serial:
+        study = run_serial(base, ranges, args.samples, args.seed, speeds, _progress)
+    else:
+        study = run_ray(base, ranges, args.samples, args.seed, speeds, args.address,
+                        args.workers, args.batch_size, _progress)
+    study.meta["ranges"] = args.ranges
+    nominal = evaluate_sample(base, ranges, np.array([r.nominal for r in ranges]), study.speeds)
+    summary = summarize(study, nominal)
+    out = Path(args.out or f"runs/montecarlo/seed{args.seed}_n{args.samples}")
+    files = write_outputs(study, summary, out, plot=not args.no_plot)
+    if args.json:
+        print(json.dumps(summary, indent=1, default=float))
+    else:
+        print(format_summary(summary))
+        print("wrote " + ", ".join(str(f) for f in files))
+    return 0
+
+
+def _pct(x: float) -> str:
+    return f"{100 * x:5.1f}" if math.isfinite(x) else "  -  "
+
+
+def format_summary(s: dict) -> str:
+    """The study's summary as text."""
+    ev = s["stable_everywhere"]
+    lo, hi = ev["ci95"]
+    lines = [
+        f"Monte Carlo: {s['samples']} parameter sets ({s['meta'].get('ranges', 'documented')} "
+        f"ranges, seed {s['seed']}), {s['backend']}: {s['seconds']:.1f} s, "
+        f"{s['sets_per_s']:.2f} sets/s",
+        f"stable at every wind speed: {ev['count']}/{s['samples']} = {100 * ev['fraction']:.1f} %"
+        f" (95 % CI {100 * lo:.1f}-{100 * hi:.1f} %); complete sweeps {s['complete']}, "
+        f"failed {s['n_errors']}",
+    ]
+    lines += _probability_lines(s)
+    lines.append("Table 2 periods at 1 m/s [s]: median [5 %, 95 %] (sets where the mode "
+                 "oscillates)")
+    for key in PERIOD_KEYS:
+        d = s["periods_s"][key]
+        if d["n"]:
+            lines.append(f"  {key:14s} {d['p50']:8.3f} [{d['p5']:.3f}, {d['p95']:.3f}]  "
+                         f"n = {d['n']}")
+    z = s["min_zeta"]
+    if z["n"]:
+        lines.append(f"smallest damping ratio: median {z['p50']:.4f} [5 %: {z['p5']:.4f}, "
+                     f"95 %: {z['p95']:.4f}]; {z['divergences']} sets with a divergence "
+                     "(a real positive eigenvalue, zeta = -1)")
+    lines.append("parameters vs instability: r (unstable somewhere), Spearman rho (max Re "
+                 "lambda), unstable rate in the low / high fifth of the range")
+    for r in s["correlations"]:
+        lines.append(f"  {r['parameter']:26s} r {r['r_unstable']:+.3f}  rho {r['rho_max_real']:+.3f}"
+                     f"  {_pct(r['unstable_rate_low_fifth'])} % / {_pct(r['unstable_rate_high_fifth'])} %")
+    for m in s["mode_instabilities"]:
+        u = m["speeds_m_s"]
+        lines.append(f"  unstable {m['mode']}: {m['samples_unstable']} sets, at {len(u)} speeds in "
+                     f"{min(u):g}-{max(u):g} m/s; follows {m['top_parameter']} (r {m['r']:+.2f})")
+    return "\n".join(lines)
+
+
+def _probability_lines(s: dict) -> list[str]:
+    """P(stable) in percent at the speeds where some mode is below 100 %, for 'all modes' and
+    every mode that is ever below 100 %."""
+    table: dict = {}
+    for r in s["stability"]:
+        table.setdefault(r["mode"], {})[r["wind_speed_m_s"]] = r["p_stable"]
+    shown = [m for m, row in table.items()
+             if m == "all modes" or any(math.isfinite(v) and v < 1 for v in row.values())]
+    speeds = [u for u in s["speeds_m_s"] if any(table[m][u] < 1 for m in shown)]
+    if not speeds:
+        return ["probability of stability: 100 % for every mode at every speed of the sweep"]
+    out = ["probability of stability [%] where it is below 100 % (100 % at every other speed)",
+           f"  {'U [m/s]':>8s}" + "".join(f"{m:>26s}" for m in shown)]
+    for u in speeds:
+        out.append(f"  {u:8g}" + "".join(f"{_pct(table[m][u]):>26s}" for m in shown))
+    return out

@@ -1,0 +1,23 @@
+"""Session-wide fixtures.
+
+``ray_session``: one local Ray instance with two CPUs for every test that needs Ray (start-up
+costs a few seconds, so it is paid once). Tests that use it are skipped, with the reason, when
+the optional ``ray`` extra is not installed.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+
+@pytest.fixture(scope="session")
+def ray_session():
+    """The ``ray`` module with a local two-CPU session running; shut down at the end."""
+    ray = pytest.importorskip(
+        "ray", reason="the optional 'ray' extra is not installed (pip install -e '.[ray]')")
+    started = not ray.is_initialized()
+    if started:
+        ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
+    yield ray
+    if started:
+        ray.shutdown()

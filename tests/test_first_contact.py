@@ -1,0 +1,151 @@
+"""First contact: the installed package finds its data from any directory, the hyperparameter
+files are rl-zoo3's own format, the registered tasks reproduce their conditions, and the CLI
+says what is wrong in one line."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import tomllib
+import yaml
+
+import aerostat_gym
+from aerostat_gym.agents.train import load_hyperparams, normalize_kwargs
+from aerostat_gym.registration import TASKS
+from aerostat_gym.resources import SHIPPED_POLICY, shipped_path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _cli(args, cwd, timeout=900):
+    """Run the installed command line in another directory (a fresh Python process)."""
+    env = {**os.environ, "PYTHONPATH": ""}
+    return subprocess.run([sys.executable, "-m", "aerostat_gym.cli", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def test_every_package_folder_is_installed():
+    """pyproject's explicit package list names every package folder under aerostat_gym/, and
+    the agents/ folder installs as aerostat_gym.shipped with its policy and hyperparameters."""
+    cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    listed = set(cfg["packages"])
+    found = {".".join(p.parent.relative_to(ROOT).parts)
+             for p in (ROOT / "aerostat_gym").rglob("__init__.py")}
+    assert found <= listed, f"not installed: {sorted(found - listed)}"
+    assert cfg["package-dir"]["aerostat_gym.shipped"] == "agents"
+    for rel in (SHIPPED_POLICY, "ppo_tethered_aerostat_vecnormalize.pkl", "hyperparams/ppo.yml"):
+        assert shipped_path(*rel.split("/")).is_file(), rel
+
+
+def test_missing_shipped_file_is_one_clear_line():
+    with pytest.raises(FileNotFoundError, match="shipped file hyperparams/nope.yml not found"):
+        shipped_path("hyperparams", "nope.yml")
+
+
+@pytest.mark.parametrize("task_id", sorted(TASKS))
+def test_registered_tasks_reproduce_their_conditions(task_id):
+    """gym.make(ID) with no kwargs builds the task's registered conditions."""
+    env = gym.make(task_id)
+    kwargs, description = TASKS[task_id]
+    task = env.unwrapped.task
+    for key, value in kwargs.items():
+        assert getattr(task, key) == value, key
+    assert description
+    assert env.spec.max_episode_steps == 600
+
+
+def test_shipped_policy_trained_on_its_registered_task():
+    """The shipped PPO's hyperparameter block is keyed by the task it was trained on, whose
+    registered kwargs equal the conditions recorded with the training run."""
+    task_id, hp, project = load_hyperparams("ppo")
+    assert task_id == "TetheredAerostatDamping-v0"
+    recorded = yaml.safe_load((ROOT / "agents" / "ppo_training" / "hyperparams.yml").read_text())
+    assert recorded["TetheredAerostat-v0"]["env_kwargs"] == TASKS[task_id][0]
+    # the normalisation is the one the shipped run used (gamma added as the zoo does)
+    assert normalize_kwargs(hp) == recorded["TetheredAerostat-v0"]["normalize"]
+    assert project == {"eval_freq": 100000, "eval_suite": "damping"}
+
+
+@pytest.mark.parametrize("value, expect", [
+    ("dict(norm_obs=True, norm_reward=False)", {"norm_obs": True, "norm_reward": False}),
+    (True, {}), (False, None)])
+def test_normalize_in_the_zoo_format(value, expect):
+    assert normalize_kwargs({"normalize": value}) == expect
+
+
+def test_normalize_is_parsed_not_evaluated():
+    with pytest.raises(ValueError, match="normalize must be"):
+        normalize_kwargs({"normalize": "__import__('os').system('true')"})
+
+
+def test_rl_zoo3_trains_on_the_shipped_yaml(tmp_path):
+    """rl-zoo3 reads the shipped PPO file unchanged and trains a few thousand steps on the
+    registered task (hyperparameters shrunk on the zoo's own command line only)."""
+    pytest.importorskip("rl_zoo3")
+    conf = shipped_path("hyperparams", "ppo.yml")
+    cmd = [sys.executable, "-m", "rl_zoo3.train", "--algo", "ppo",
+           "--env", "TetheredAerostatDamping-v0", "--gym-packages", "aerostat_gym",
+           "--conf-file", str(conf), "-n", "2048", "--eval-freq", "-1", "--seed", "0",
+           "--log-folder", str(tmp_path), "--vec-env", "dummy", "--device", "cpu",
+           "--hyperparams", "n_envs:2", "n_steps:512", "batch_size:256", "n_epochs:1"]
+    out = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stderr[-2000:]
+    saved = list(tmp_path.rglob("TetheredAerostatDamping-v0.zip"))
+    assert saved, out.stdout[-2000:]
+    from stable_baselines3 import PPO
+
+    assert PPO.load(saved[0], device="cpu").num_timesteps == 2048
+
+
+def test_commands_work_from_any_directory(tmp_path):
+    """demo, train and evaluate run from a directory outside the repository with the installed
+    package only, and write what they say they write."""
+    demo = _cli(["demo", "--out", "demo"], tmp_path)
+    assert demo.returncode == 0, demo.stderr[-2000:]
+    assert "linear stability: all modes stable = True" in demo.stdout
+    report = (tmp_path / "demo" / "report.md").read_text()
+    assert "## Trim and linear stability" in report and "ppo_tethered_aerostat" in report
+    train = _cli(["train", "--timesteps", "2000", "--n-envs", "4", "--run-dir", "run",
+                  "--eval-freq", "1000000000", "--no-progress", "--threads", "1"], tmp_path)
+    assert train.returncode == 0, train.stderr[-2000:]
+    summary = json.loads((tmp_path / "run" / "training_summary.json").read_text())
+    assert summary["task"] == "TetheredAerostatDamping-v0" and summary["timesteps"] == 2000
+    command = (tmp_path / "run" / "command.txt").read_text()
+    assert command.startswith("aerostat-gym train") and str(tmp_path) not in command
+    ev = _cli(["evaluate", "--policy", "passive", "--policy", "run/ppo_final.zip",
+               "--suite", "damping", "--out", "ev", "--no-plots"], tmp_path)
+    assert ev.returncode == 0, ev.stderr[-2000:]
+    assert "](" not in ev.stdout  # no Markdown image links on the terminal
+    rows = json.loads((tmp_path / "ev" / "report.json").read_text())
+    assert [r["label"] for r in rows] == ["passive", "ppo_final"]
+    assert all(np.isfinite(e["pendulum_zeta"]) for e in rows[0]["scenarios"]["recover"]["episodes"])
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["demo", "--policy", "missing.zip"], "policy file not found: missing.zip"),
+    (["train", "--timesteps", "0"], "--timesteps must be >= 1"),
+    (["train", "--hyperparams", "nope.yml"], "hyperparameter file not found: nope.yml"),
+])
+def test_bad_input_is_one_line_on_stderr(tmp_path, args, needle):
+    out = _cli(args, tmp_path, timeout=300)
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], out.stderr[-1000:]
+
+
+def test_help_has_defaults_and_no_markup():
+    from aerostat_gym.cli import build_parser
+
+    text = build_parser().format_help()
+    assert "``" not in text and ":func:" not in text
+    sub = build_parser()._subparsers._group_actions[0].choices
+    assert "(default: shipped)" in sub["demo"].format_help()
+    assert "(default: tiny)" in sub["evaluate"].format_help()
+    assert aerostat_gym.__version__
