@@ -14,7 +14,7 @@ import argparse
 
 import numpy as np
 
-from aerostat_gym.analysis.intensity import air_inertia_force, realised_intensity
+from aerostat_gym.agents.intensity import air_inertia_force, realised_intensity
 from aerostat_gym.params import load_params
 from aerostat_gym.wind import build_wind
 from aerostat_gym.wind.presets import INTENSITY_MODELS

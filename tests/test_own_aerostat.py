@@ -384,7 +384,7 @@ def test_turbulence_field_sized_from_the_configuration():
                                  "wind.turbulence_reference_height": 550.0})
     env = gym.make(ENV_ID, params=p, turbulence="config", max_episode_steps=5)
     turb = env.unwrapped.task.resolved["turbulence"]
-    assert (turb.sigma_u, turb.model, turb.reference_height) == (0.8, "dryden", 550.0)
+    assert (turb.intensity, turb.model, turb.reference_height) == ("light", "dryden", 550.0)
     env.close()
     wp, wf = configured_wind(p, 30.0, np.random.default_rng(0), speed=8.0)
     assert wf.shape[0] == sized_turbulence(p).heights()[2]

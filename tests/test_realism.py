@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
+from aerostat_gym.agents.intensity import realised_intensity
 from aerostat_gym.agents.sideslip import yaw_curve
-from aerostat_gym.analysis.intensity import realised_intensity
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.params import load_params
 from aerostat_gym.physics.core import _hull, fin_coefficients, rhs, rotation_matrix

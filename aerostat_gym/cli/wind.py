@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from ..analysis.intensity import air_inertia_force
+from ..agents.intensity import air_inertia_force
 from ..params import load_params
 from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
 from ..wind.field import build_wind, field_heights, field_times, mean_vector

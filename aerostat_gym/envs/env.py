@@ -162,10 +162,10 @@ class TetheredAerostatEnv(gym.Env):
     ## Version History
 
     - v0: initial release (aerostat-gym 0.1).
-    - v0, unchanged dynamics, observation and reward (bit-identical episodes): ``reward_fn``
+    - v0 (aerostat-gym 0.2), unchanged dynamics, observation and reward: ``reward_fn``
       argument, ``info["peak_tension"]``, ``get_state`` / ``set_state``; the pitch channel's
       documented sign corrected (positive is nose down, as it always was).
-    - v0, issue 13 (dynamics changed, id kept because the mission names it): turbulence
+    - v0 (aerostat-gym 0.2; dynamics changed, id kept as the package's public name): turbulence
       classes scale with each episode's mean wind (MIL-F-8785C, TI 5 / 10 / 15 % at 300 m, was
       fixed sigma_u 0.8 / 1.6 / 2.4 m/s); fins with Viterna-Corrigan post-stall normal force
       beyond a 45 deg stall (was C_L flat beyond 16 deg); the turbulence field sized from the
