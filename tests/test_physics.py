@@ -10,8 +10,8 @@ import pytest
 
 from aerostat_gym.analysis.energy import mechanical_energy
 from aerostat_gym.analysis.signals import zero_crossing_period
-from aerostat_gym.analysis.trim import TrimError, find_equilibrium
-from aerostat_gym.params import load_params
+from aerostat_gym.analysis.trim import find_equilibrium
+from aerostat_gym.params import ParameterError, load_params
 from aerostat_gym.sim import Model, SimulationError, simulate
 
 AERO_OFF = {"hull.CD0": 0.0, "hull.Cdc": 0.0, "hull.eta_k": 0.0, "fins.CL_alpha": 0.0,
@@ -224,10 +224,12 @@ def test_invalid_inputs_raise_clear_errors(base, trim0):
 
 
 def test_tether_break_is_reported(base, trim0):
-    """A tether weaker than the net lift breaks at once: reported as status 'break' with the
-    time and the tension, not an exception."""
-    weak = base.replace(**{"tether.strength": 1000.0})
-    tr = simulate(weak, trim0.x, 5.0, wind=0.0)
+    """A 3 kN tether (above the 2.6 kN still-air tension, so it loads, but below the 3.8 kN
+    trim at 15 m/s) hit by a sudden 15 m/s wind breaks: reported as status 'break' with the
+    time and the tension, not an exception. (A tether weaker than the net lift is refused when
+    the parameters are loaded.)"""
+    weak = base.replace(**{"tether.strength": 3000.0, "winch.safe_working_load": 1000.0})
+    tr = simulate(weak, trim0.x, 5.0, wind=15.0)
     assert tr.status == "break"
     assert tr.events[-1]["event"] == "break" and "exceeded" in tr.events[-1]["message"]
 
@@ -258,8 +260,7 @@ def test_nonfinite_state_is_reported_not_raised(base, trim0):
 
 
 def test_trim_failure_is_an_error():
-    """No equilibrium (net lift 52 N cannot hold up the 70 N tether) is a clear TrimError that
-    names the wind speed, never a wrong answer."""
-    p = load_params(overrides={"aerostat.mass": 590.0})
-    with pytest.raises(TrimError, match="U = 0"):
-        find_equilibrium(p, 0.0)
+    """No equilibrium (net lift 52 N cannot hold up the 70 N tether) is a clear error, never a
+    wrong answer: refused when the parameters are loaded, naming the fields."""
+    with pytest.raises(ParameterError, match="cannot lift its tether"):
+        load_params(overrides={"aerostat.mass": 590.0})
