@@ -383,6 +383,34 @@ def test_10_infeasible_randomisation_range_refused_when_made():
         TetheredAerostatEnv(randomize={"aerostat.mass": 0.9}, n_elements=5, **QUIET)
 
 
+def test_10_infeasible_draws_are_redrawn_a_bounded_number_of_times(monkeypatch):
+    """A draw whose trim fails is redrawn: three failing trims, then the fourth draw is used
+    (four draws of the randomised parameter); a trim that always fails is a TaskError after
+    MAX_REDRAWS draws, never a TrimError out of reset."""
+    env = TetheredAerostatEnv(randomize={"aerostat.Ixx": 0.3}, n_elements=5,
+                              wind_speed=(5.0, 5.0), **QUIET)
+    real = episodes.find_equilibrium
+    calls = []
+
+    def flaky(params, *args, **kwargs):
+        calls.append(params.aerostat.Ixx)
+        if len(calls) <= 3:
+            raise trim_module.TrimError("no equilibrium (test)")
+        return real(params, *args, **kwargs)
+
+    monkeypatch.setattr(episodes, "find_equilibrium", flaky)
+    env.reset(seed=0)
+    assert len(calls) == 4 and len(set(calls)) == 4
+    assert env.episode.params.aerostat.Ixx == calls[-1]
+
+    def never(*args, **kwargs):
+        raise trim_module.TrimError("no equilibrium (test)")
+
+    monkeypatch.setattr(episodes, "find_equilibrium", never)
+    with pytest.raises(TaskError, match=f"no feasible aerostat in {episodes.MAX_REDRAWS} draws"):
+        env.reset(seed=1)
+
+
 def test_10_wide_randomisation_resets_never_raise():
     """+-90 % on the estimated inertias and coefficients: 40 resets, all feasible trims."""
     spec = {"aerostat.Ixx": 0.9, "aerostat.Iyy": 0.9, "aerostat.Izz": 0.9, "hull.Cdc": 0.9,

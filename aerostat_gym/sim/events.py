@@ -14,7 +14,11 @@ from ..physics.packing import P_ANCHOR, P_NEL, P_STRENGTH, P_W_LMAX, P_W_LMIN, P
 from ..physics.state import S_LENGTH, S_P, S_REEL, S_VX, S_X, S_Z, aerostat_offset
 
 #: Outcome codes of a control step. DIVERGED and NONFINITE_OUTPUT are numerical failures, like
-#: NONFINITE: the integration, not the physics, has gone wrong.
+#: NONFINITE: the integration, not the physics, has gone wrong. DIVERGED is a finite state
+#: beyond every physical bound (:func:`diverged`) or, in the environments, a terminating event
+#: (break, ground strike, length limit) that half the integration step does not reproduce
+#: (:func:`aerostat_gym.envs.kernel._confirmed`): an integrator past its stability step, or a
+#: step too coarse to resolve a tension peak near the strength.
 (RUNNING, NONFINITE, TETHER_BREAK, GROUND_STRIKE, LENGTH_LIMIT, FIELD_END, DIVERGED,
  NONFINITE_OUTPUT) = range(8)
 #: Reason strings (``info["termination"]``, ``info["failure"]``, ``info["truncation"]``).
