@@ -14,18 +14,15 @@ from __future__ import annotations
 import argparse
 
 from aerostat_gym.analysis.figures import FIG8_VARIABLES, write_figure8
-from aerostat_gym.cli.common import parse_overrides
-from aerostat_gym.params import load_params
+from aerostat_gym.cli.common import add_config, params_from_args
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", required=True, help="output folder")
-    ap.add_argument("--config", help="parameter TOML or a shipped configuration's name (default: the baseline)")
-    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                    help="override one parameter (repeatable)")
+    add_config(ap, json=False)
     args = ap.parse_args(argv)
-    res = write_figure8(args.out, load_params(args.config, parse_overrides(args.set) or None))
+    res = write_figure8(args.out, params_from_args(args))
     names = [name for name, _unit in FIG8_VARIABLES]
     print("normalised RMS difference, linear vs nonlinear [%]")
     print(f"  {'axes':38s} {'nodes':8s}" + "".join(f"{n:>7s}" for n in names) + "  tension swing")

@@ -12,19 +12,16 @@ from __future__ import annotations
 import argparse
 
 from aerostat_gym.analysis.figures import write_families, write_figure9
-from aerostat_gym.cli.common import parse_overrides
-from aerostat_gym.params import load_params
+from aerostat_gym.cli.common import add_config, params_from_args
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", required=True, help="output folder")
-    ap.add_argument("--config", help="parameter TOML or a shipped configuration's name (default: the baseline)")
-    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                    help="override one parameter (repeatable)")
+    add_config(ap, json=False)
     ap.add_argument("--no-families", action="store_true", help="skip the length / pitch families")
     args = ap.parse_args(argv)
-    params = load_params(args.config, parse_overrides(args.set) or None)
+    params = params_from_args(args)
     data = write_figure9(args.out, params)
     print(f"Figure 9: {len(data['wind_speed_m_s'])} speeds in {data['seconds']:.2f} s, "
           f"all modes stable: {data['all_stable']}")

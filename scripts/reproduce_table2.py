@@ -19,21 +19,18 @@ from aerostat_gym.analysis.sensitivity import (
     lateral_pendulum_fixes,
     sensitivity_table,
 )
-from aerostat_gym.cli.common import parse_overrides
-from aerostat_gym.params import load_params
+from aerostat_gym.cli.common import add_config, params_from_args
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", required=True, help="output folder")
-    ap.add_argument("--config", help="parameter TOML or a shipped configuration's name (default: the baseline)")
-    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                    help="override one parameter (repeatable)")
+    add_config(ap, json=False)
     ap.add_argument("--no-sensitivity", action="store_true", help="Table 2 only")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    params = load_params(args.config, parse_overrides(args.set) or None)
+    params = params_from_args(args)
     rows = table2(params)
     (out / "table2.json").write_text(json.dumps(rows, indent=1))
     write_table(rows, out / "table2.csv")

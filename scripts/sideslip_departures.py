@@ -16,8 +16,7 @@ from __future__ import annotations
 import argparse
 
 from aerostat_gym.agents.sideslip import OFFSETS_DEG, max_sideslip, yaw_curve
-from aerostat_gym.cli.common import parse_overrides
-from aerostat_gym.params import load_params
+from aerostat_gym.cli.common import add_config, params_from_args
 
 FINS = {"configured": None,
         "flat, 16 deg": {"fins.post_stall": "flat", "fins.alpha_stall_deg": 16.0}}
@@ -29,12 +28,9 @@ def main(argv=None) -> int:
     ap.add_argument("--episodes", type=int, default=20, help="episodes per cell")
     ap.add_argument("--air-inertia", action="store_true",
                     help="repeat the episode counts with the air-inertia force on")
-    ap.add_argument("--config", help="parameter TOML or a shipped configuration's name "
-                    "(default: the baseline)")
-    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                    help="override one parameter (repeatable)")
+    add_config(ap, json=False)
     args = ap.parse_args(argv)
-    params = load_params(args.config, parse_overrides(args.set) or None)
+    params = params_from_args(args)
     print("static yaw acceleration [rad/s^2] against the yaw offset [deg]:")
     print("  fins             U m/s" + "".join(f"{d:>8d}" for d in OFFSETS_DEG))
     for name, over in FINS.items():

@@ -17,8 +17,8 @@ import sys
 import numpy as np
 
 from aerostat_gym.analysis.manoeuvre import plot_manoeuvre, reel_manoeuvre
-from aerostat_gym.cli.common import parse_overrides
-from aerostat_gym.params import ParameterError, load_params
+from aerostat_gym.cli.common import add_config, params_from_args
+from aerostat_gym.params import ParameterError
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -29,12 +29,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--hold", type=float, default=30.0, help="hold at the long length [s]")
     ap.add_argument("--settle", type=float, default=300.0, help="time after reel-in [s]")
     ap.add_argument("--integrator", choices=("rk4", "semi-implicit"), default="rk4")
-    ap.add_argument("--config", help="parameter TOML file (default: the shipped baseline)")
-    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE")
+    add_config(ap, json=False)
     ap.add_argument("--out", default="winch_manoeuvre.png", help="output PNG")
     args = ap.parse_args(argv)
     try:
-        params = load_params(args.config, parse_overrides(args.set) or None)
+        params = params_from_args(args)
         res = reel_manoeuvre(params, args.wind, args.distance, args.speed, args.hold,
                              args.settle, args.integrator)
     except (ParameterError, ValueError) as exc:

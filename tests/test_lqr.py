@@ -9,7 +9,13 @@ ratio open loop -> LQR: 5 m/s 0.151 -> 0.158, 10 m/s 0.275 -> 0.355, 15 m/s 0.35
 import numpy as np
 import pytest
 
-from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule, design_lqr, mode_initial_state
+from aerostat_gym.agents.lqr import (
+    LQRPolicy,
+    LQRSchedule,
+    design_lqr,
+    mode_initial_state,
+    set_point_law,
+)
 from aerostat_gym.agents.metrics import fit_damped_sinusoid
 from aerostat_gym.envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
 from aerostat_gym.params import load_params
@@ -174,16 +180,7 @@ def test_nonlinear_pendulum_damping_matches_linear(params):
     lay = design.linear.layout
     policy = LQRPolicy(params, dt=DT, schedule=schedule)
     dx0, z0 = mode_initial_state(design, "pendulum", 0.5)
-    state = {"z": np.array([z0])}
-    ipsi = lay.euler.start + 2
-
-    def u(t, x):
-        dx = x - design.x_trim
-        dx[ipsi] = (dx[ipsi] + np.pi) % (2 * np.pi) - np.pi
-        obs = np.zeros(OBS_FULL_STATE + lay.size)
-        obs[OBS_FULL_WIND], obs[OBS_FULL_STATE:] = 10.0, dx
-        a, state["z"] = policy.predict(obs, state["z"])
-        return [float(a[0]) * params.winch.max_speed, 0.0]
+    u = set_point_law(policy, design.x_trim, 10.0, params, state=np.array([z0]))
 
     traj = simulate(params, design.x_trim + dx0, 150.0, wind=10.0, integrator="rk4",
                     output_dt=DT, u=u)

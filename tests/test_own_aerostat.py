@@ -32,6 +32,7 @@ from aerostat_gym.agents.lqr import (
     LQRSchedule,
     mode_initial_state,
     scaled_deviations,
+    set_point_law,
 )
 from aerostat_gym.agents.metrics import fit_damped_sinusoid
 from aerostat_gym.agents.policies import load_policy
@@ -42,7 +43,6 @@ from aerostat_gym.analysis.reference import THEORY_TOLERANCE_PCT
 from aerostat_gym.analysis.sensitivity import default_knobs
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.cli import main
-from aerostat_gym.envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
 from aerostat_gym.params import (
     ParameterError,
     dumps_toml,
@@ -255,16 +255,7 @@ def lqr_damping_check(p, wind=10.0, periods=3.0):
     lay = design.linear.layout
     policy = LQRPolicy(p, dt=dt, schedule=schedule)
     dx0, z0 = mode_initial_state(design, "pendulum", 0.5 * p.tether.length / 300.0)
-    state = {"z": np.array([z0])}
-    ipsi = lay.euler.start + 2
-
-    def u(t, x):
-        dx = x - design.x_trim
-        dx[ipsi] = (dx[ipsi] + np.pi) % (2 * np.pi) - np.pi
-        obs = np.zeros(OBS_FULL_STATE + lay.size)
-        obs[OBS_FULL_WIND], obs[OBS_FULL_STATE:] = wind, dx
-        a, state["z"] = policy.predict(obs, state["z"])
-        return [float(a[0]) * p.winch.max_speed, 0.0]
+    u = set_point_law(policy, design.x_trim, wind, p, state=np.array([z0]))
 
     pred = design.mode("pendulum")
     traj = simulate(p, design.x_trim + dx0, periods * pred.period, wind=wind, integrator="rk4",

@@ -25,12 +25,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import apply_overrides, load_params
+from ..physics.state import StateLayout
 from ..sim import simulate
 from ..sim.winch_dwell import DEFAULT_DWELL_TIME, DEFAULT_STANDSTILL_BAND, DwellBrake
 from .evaluate import policy_obs
+from .lqr import set_point_law
 from .metrics import fit_damped_sinusoid
 from .metrics_drift import fit_pendulum_with_drift
 from .modal import design_modal
@@ -226,33 +227,19 @@ def swing_response_dwell(policy, wind_speed: float, swing: float, *,
     """
     params = params or load_params()
     x0, xt = initial_state(wind_speed, swing, params)
-    brake = DwellBrake(band, control_step, dwell)
-    vmax = float(params.winch.max_speed)
-    lay_size = x0.size
-    n = (lay_size - 8) // 6
-    o = 6 * (n - 1)  # first aerostat entry of the layout (CM position)
-    i_psi = o + 8
-    memo = {"state": None, "start": np.ones(1, bool), "sp": []}
-
-    def u(t, x):
-        dx = x - xt
-        dx[i_psi] = (dx[i_psi] + np.pi) % (2.0 * np.pi) - np.pi
-        obs = np.zeros(OBS_FULL_STATE + lay_size)
-        obs[OBS_FULL_WIND], obs[OBS_FULL_STATE:] = wind_speed, dx
-        a, memo["state"] = policy.predict(obs, memo["state"], memo["start"])
-        memo["start"][:] = False
-        v = float(np.clip(a[0], -1.0, 1.0)) * vmax
-        memo["sp"].append(v)
-        return brake(v)
-
+    lay = StateLayout(params.tether.n_elements)
+    set_points: list = []
+    u = set_point_law(policy, xt, wind_speed, params, DwellBrake(band, control_step, dwell),
+                      set_points)
     tr = simulate(apply_overrides(params, {"winch.brake_speed": 0.0}), x0, duration,
                   wind=wind_speed, integrator="semi-implicit", output_dt=control_step, u=u)
-    x = tr.cm_pos[:, 0] - xt[o]
+    x = tr.cm_pos[:, 0] - xt[lay.cm_pos.start]
     fit = fit_damped_sinusoid(tr.time, x)
     drift = fit_pendulum_with_drift(tr.time, x)
-    return SwingRun(float(wind_speed), float(swing), tr.time, x, tr.length - xt[o + 12],
-                    tr.reel_speed, np.array(memo["sp"]), fit.zeta, fit.period, fit.r2,
-                    None if tr.status == "ok" else tr.status, drift.zeta)
+    return SwingRun(float(wind_speed), float(swing), tr.time, x,
+                    tr.length - xt[lay.winch_length], tr.reel_speed, np.array(set_points),
+                    fit.zeta, fit.period, fit.r2, None if tr.status == "ok" else tr.status,
+                    drift.zeta)
 
 
 def linear_response(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, steps: int
