@@ -130,7 +130,7 @@ def test_commands_work_from_any_directory(tmp_path):
 
 @pytest.mark.parametrize("args, needle", [
     (["demo", "--policy", "missing.zip"], "policy file not found: missing.zip"),
-    (["train", "--timesteps", "0"], "--timesteps must be >= 1"),
+    (["train", "--timesteps", "0"], "argument --timesteps: expected an integer >= 1, got '0'"),
     (["train", "--hyperparams", "nope.yml"], "hyperparameter file not found: nope.yml"),
 ])
 def test_bad_input_is_one_line_on_stderr(tmp_path, args, needle):

@@ -39,8 +39,6 @@ def add_train_parser(sub) -> None:
 
 
 def _train_command(args) -> int:
-    if args.timesteps is not None and args.timesteps < 1:
-        raise ValueError(f"--timesteps must be >= 1, got {args.timesteps}")
     params = params_from_args(args) if (args.config or args.set) else None
     run = train(args.algo, args.hyperparams, args.timesteps, args.n_envs, args.seed,
                 args.run_dir, args.resume, not args.no_progress, args.threads, args.eval_freq,
