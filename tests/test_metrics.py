@@ -108,3 +108,23 @@ def test_response_metrics_two_modes():
     # closed form of the 5 % settling time is not simple for a damped cosine; bound it by the
     # envelope: the envelope 0.5 exp(-zeta wn t) reaches 5 % of 0.5 at ln(20)/(zeta wn) = 66.8 s
     assert 0.0 < m["settling_time_s"] <= math.log(20) / (0.3 * 2 * np.pi / 42.0) + 0.2
+
+
+def _result(label, score, zetas):
+    eps = [{"wind_speed": u, "pendulum_zeta": z} for u, z in zip((5.0, 10.0, 15.0), zetas,
+                                                                   strict=True)]
+    return {"label": label, "score": score, "scenarios": {"recover": {"episodes": eps}}}
+
+
+def test_report_verdicts_use_the_stated_tolerance():
+    """A damping difference within ZETA_TOLERANCE is not called better or worse."""
+    from aerostat_gym.agents.report import ZETA_TOLERANCE, score_and_damping, verdicts
+
+    passive = _result("passive", -30.0, [0.156, 0.285, 0.364])
+    ppo = _result("ppo", -40.0, [0.156 + 0.5 * ZETA_TOLERANCE, 0.339, 0.35])
+    lines = verdicts([passive, ppo])
+    assert [ln.rsplit(": ", 1)[1] for ln in lines] == [
+        f"within the {ZETA_TOLERANCE} tolerance", "better", "worse"]
+    text = score_and_damping([passive, ppo])
+    assert "ranks passive first" in text and "damping ranks ppo first" in text
+    assert score_and_damping([passive]) == "The score and the pendulum damping both rank passive first."

@@ -77,12 +77,20 @@ def lqr_predictions(results: list[dict]) -> str:
             "pitch zeta, LQR (nonlinear fit) |\n|---|---|---|---|---|---|\n" + "\n".join(lines))
 
 
+#: Pendulum damping-ratio differences below this are called "within tolerance", not better or
+#: worse: the recover scenario is one deterministic episode per wind speed, and the damped-sinusoid
+#: fit of the braked winch differs from its linear eigenvalue by about this much (0.285 fitted
+#: against 0.277 linear at 10 m/s).
+ZETA_TOLERANCE = 0.01
+
+
 def verdicts(results: list[dict]) -> list[str]:
-    """Plain statements: where each learned policy beats passive and LQR on pendulum damping."""
+    """Plain statements: where each learned policy damps the pendulum better than passive and
+    LQR by more than :data:`ZETA_TOLERANCE`, worse by more than it, or within it."""
     by = {r["label"]: r for r in results}
     out = []
     for r in results:
-        if r["label"] in ("passive", "tension", "lqr"):
+        if r["label"] in ("passive", "tension", "lqr", "modal", "lqg"):
             continue
         for ref in ("passive", "lqr"):
             if ref not in by:
@@ -91,11 +99,28 @@ def verdicts(results: list[dict]) -> list[str]:
                 u = e["wind_speed"]
                 f = next(x for x in by[ref]["scenarios"]["recover"]["episodes"]
                          if x["wind_speed"] == u)
-                better = e["pendulum_zeta"] > f["pendulum_zeta"]
+                d = e["pendulum_zeta"] - f["pendulum_zeta"]
+                word = ("better" if d > ZETA_TOLERANCE else "worse" if d < -ZETA_TOLERANCE
+                        else f"within the {ZETA_TOLERANCE} tolerance")
                 out.append(f"- {r['label']} vs {ref} at {u:g} m/s: pendulum zeta "
-                           f"{e['pendulum_zeta']:.3f} vs {f['pendulum_zeta']:.3f}: "
-                           f"{'better' if better else 'NOT better'}")
+                           f"{e['pendulum_zeta']:.3f} vs {f['pendulum_zeta']:.3f}: {word}")
     return out
+
+
+def score_and_damping(results: list[dict]) -> str:
+    """One sentence reconciling the score (mean return) with the recover-scenario damping: which
+    policy each ranks first, and why they may differ."""
+    best_score = max(results, key=lambda r: r["score"])["label"]
+    zeta = {r["label"]: _mean(r["scenarios"]["recover"]["episodes"], "pendulum_zeta")
+            for r in results if "recover" in r["scenarios"]}
+    if not zeta:
+        return ""
+    best_zeta = max(zeta, key=lambda k: zeta[k] if math.isfinite(zeta[k]) else -math.inf)
+    if best_zeta == best_score:
+        return f"The score and the pendulum damping both rank {best_score} first."
+    return (f"The score (mean return) ranks {best_score} first; the pendulum damping ranks "
+            f"{best_zeta} first: the return also charges the length wander and the winch effort "
+            "(reward terms `length`, `effort`, `effort_rate`), which the damping ratio ignores.")
 
 
 def plot(results: list[dict], out: Path) -> list[Path]:
@@ -155,7 +180,8 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
              f"Suite `{results[0]['suite']}`: {json.dumps(SUITES[results[0]['suite']])} "
              "(scenario: (wind speeds, seeds)). Control step 0.2 s.", "",
              "Scores (mean episode return, default reward): " +
-             ", ".join(f"{r['label']} {r['score']:.0f}" for r in results), ""]
+             ", ".join(f"{r['label']} {r['score']:.0f}" for r in results) + ". " +
+             score_and_damping(results), ""]
     for scenario in results[0]["scenarios"]:
         parts += [f"## {scenario}", "", comparison_table(results, scenario), ""]
     pred = lqr_predictions(results)

@@ -152,14 +152,14 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
                      n_envs, timesteps)
     model = _model(algo, hp, venv, seed, run, resume)
     freq = int(eval_freq or project.get("eval_freq", 50_000))
-    callbacks = CallbackList([
-        CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"), name_prefix=algo,
-                           save_vecnormalize=True),
-        suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1), run,
-                            env_kwargs.get("params"), on_eval),
-    ])
+    suite_cb = suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1),
+                                   run, env_kwargs.get("params"), on_eval)
+    callbacks = [CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"),
+                                    name_prefix=algo, save_vecnormalize=True), suite_cb]
+    if progress_bar:
+        callbacks.append(progress_callback(timesteps, suite_cb))
     t0 = time.perf_counter()
-    model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress_bar,
+    model.learn(total_timesteps=timesteps, callback=CallbackList(callbacks),
                 reset_num_timesteps=resume is None, tb_log_name=algo)
     wall = time.perf_counter() - t0
     save_model(model, run / f"{algo}_final.zip")
@@ -211,6 +211,41 @@ def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=N
                 on_eval({**self.history[-1], "best": best}, Path(run))
 
     return SuiteEvalCallback()
+
+
+def progress_callback(total: int, suite_cb):
+    """A progress bar over the requested steps (it stops at ``total`` even when the last
+    rollout overshoots), showing the mean return of the last 100 episodes and the latest suite
+    evaluation score."""
+    from stable_baselines3.common.callbacks import BaseCallback
+    from tqdm import tqdm
+
+    class ProgressCallback(BaseCallback):
+        def _on_training_start(self) -> None:
+            self.bar = tqdm(total=total, unit="step", desc="training")
+            self.start = self.num_timesteps
+
+        def _on_step(self) -> bool:
+            done = min(self.num_timesteps - self.start, total)
+            self.bar.update(done - self.bar.n)
+            if self.n_calls % 50 == 0:
+                self.bar.set_postfix(self.status(), refresh=False)
+            return True
+
+        def status(self) -> dict:
+            out = {}
+            episodes = self.model.ep_info_buffer
+            if episodes:
+                out["return"] = f"{np.mean([e['r'] for e in episodes]):.1f}"
+            if suite_cb.history:
+                out["eval"] = f"{suite_cb.history[-1]['score']:.1f}"
+            return out
+
+        def _on_training_end(self) -> None:
+            self.bar.set_postfix(self.status())
+            self.bar.close()
+
+    return ProgressCallback()
 
 
 def _tensorboard_dir(run: Path) -> str | None:
