@@ -128,3 +128,22 @@ def test_report_verdicts_use_the_stated_tolerance():
     text = score_and_damping([passive, ppo])
     assert "ranks passive first" in text and "damping ranks ppo first" in text
     assert score_and_damping([passive]) == "The score and the pendulum damping both rank passive first."
+
+
+def test_report_json_carries_intervals_per_cell():
+    """cell_means: per wind speed the mean over seeds with a 95 % interval around it for every
+    numeric metric; one seed gives the point itself."""
+    from aerostat_gym.agents.protocol_stats import bootstrap_mean_ci
+    from aerostat_gym.agents.report import cell_means
+
+    eps = [{"wind_speed": 10.0, "seed": s, "rms_x_m": v, "ended": None}
+           for s, v in zip((100, 101, 102), (8.0, 9.5, 7.0), strict=True)]
+    eps.append({"wind_speed": 15.0, "seed": 100, "rms_x_m": 12.0, "ended": None})
+    cells = cell_means(eps)
+    assert [c["wind_speed"] for c in cells] == [10.0, 15.0]
+    ten = cells[0]
+    want = bootstrap_mean_ci([8.0, 9.5, 7.0], method="percentile")  # few seeds: percentile
+    assert ten["n_seeds"] == 3 and ten["rms_x_m"] == pytest.approx(np.mean([8.0, 9.5, 7.0]))
+    assert ten["rms_x_m_ci"] == [want.low, want.high]
+    assert want.low < ten["rms_x_m"] < want.high
+    assert cells[1]["rms_x_m_ci"] == [12.0, 12.0] and "ended" not in ten and "seed" not in ten

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..resources import SHIPPED_POLICY
 from .evaluate import SUITES, evaluate_policy
+from .protocol_stats import bootstrap_mean_ci
 
 COLUMNS = [  # (key, header, format)
     ("pendulum_zeta", "pend. zeta", "{:.3f}"), ("pendulum_period_s", "pend. T [s]", "{:.1f}"),
@@ -203,12 +204,47 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
 
 
 def jsonable(results: list[dict]) -> list[dict]:
+    """The results as JSON-ready data: per scenario the episodes and, per wind speed, the mean
+    of every metric over the seeds with its 95 % bootstrap interval (``cells``)."""
     out = []
     for r in results:
         r2 = {k: v for k, v in r.items() if k != "scenarios"}
-        r2["scenarios"] = {s: {"episodes": d["episodes"]} for s, d in r["scenarios"].items()}
+        r2["scenarios"] = {s: {"episodes": d["episodes"], "cells": cell_means(d["episodes"])}
+                           for s, d in r["scenarios"].items()}
         out.append(r2)
     return out
+
+
+#: Seeds from which a cell's interval is studentized (the protocol's default method).
+STUDENTIZED_MIN_SEEDS = 10
+
+
+def cell_means(episodes: list[dict]) -> list[dict]:
+    """Per wind speed: ``n_seeds`` and, for every numeric metric, its mean over the seeds and
+    ``<metric>_ci``, its 95 % bootstrap interval
+    (:func:`aerostat_gym.agents.protocol_stats.bootstrap_mean_ci`): studentized from
+    :data:`STUDENTIZED_MIN_SEEDS` seeds, percentile below (with two or three seeds the
+    studentized interval degenerates: most resamples have no spread); with one seed, or one
+    finite value, the interval is the value itself."""
+    cells = []
+    for u in sorted({e["wind_speed"] for e in episodes}):
+        eps = [e for e in episodes if e["wind_speed"] == u]
+        cell = {"wind_speed": u, "n_seeds": len(eps)}
+        for key in eps[0]:
+            vals = [e[key] for e in eps]
+            if key in ("wind_speed", "seed") or not all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
+                continue
+            x = np.array([v for v in vals if math.isfinite(v)], dtype=float)
+            if x.size == 0:
+                continue
+            if x.size == 1 or np.ptp(x) == 0.0:
+                cell[key], cell[key + "_ci"] = float(x[0]), [float(x[0]), float(x[0])]
+            else:
+                method = "studentized" if x.size >= STUDENTIZED_MIN_SEEDS else "percentile"
+                cell.update(bootstrap_mean_ci(x, method=method).as_dict(key))
+        cells.append(cell)
+    return cells
 
 
 def run_evaluations(policies: list[str], suite: str, progress: bool = True,
