@@ -75,32 +75,43 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     b, lay = env.batch, env.batch.layout
     ix, ith, iv = lay.cm_pos.start, lay.euler.start + 1, lay.winch_speed
     rec = {k: np.zeros((len(pairs), steps + 1)) for k in ("x", "pitch", "tension", "reel")}
-    alive = np.ones(len(pairs), bool)
-    ended, returns = [None] * len(pairs), np.zeros(len(pairs))
-    state, start = None, np.ones(len(pairs), bool)
 
-    def record(k):
+    def record(k, obs, alive):
         rec["x"][:, k] = np.where(alive, b.state[:, ix] - b.trim_state[:, ix], np.nan)
         rec["pitch"][:, k] = np.where(alive, b.state[:, ith] - b.trim_state[:, ith], np.nan)
         rec["tension"][:, k] = np.where(alive, obs[:, OBS_TENSION] * CHANNELS[OBS_TENSION].scale,
                                         np.nan)
         rec["reel"][:, k] = np.where(alive, b.state[:, iv], np.nan)
 
-    record(0)
-    for k in range(1, steps + 1):
-        action, state = policy.predict(policy_obs(policy, obs), state=state, episode_start=start,
-                                       deterministic=True)
-        start[:] = False
-        obs, rew, term, trunc, info = env.step(np.asarray(action, np.float32).reshape(-1, 1))
-        returns += np.where(alive, rew, 0.0)
-        for i in np.flatnonzero(term & alive):
-            ended[i] = info["termination"][i]
-        alive &= ~term
-        record(k)
+    returns, ended = rollout(policy, env, obs, steps, record)
     env.close()
     t = np.arange(steps + 1) * control_step
     return Episodes(scenario, np.array([u for u, _ in pairs]), np.array([s for _, s in pairs]),
                     t, rec["x"], rec["pitch"], rec["tension"], rec["reel"], returns, ended)
+
+
+def rollout(policy, env, obs: np.ndarray, steps: int, record=None) -> tuple[np.ndarray, list]:
+    """Run ``policy`` deterministically for ``steps`` steps on a vector env just reset to
+    ``obs``; returns (episode return per environment, termination reason or None). Rewards
+    count until an environment terminates; ``record(k, obs, alive)`` is called after the reset
+    (k = 0) and after every step."""
+    n = obs.shape[0]
+    alive, ended, returns = np.ones(n, bool), [None] * n, np.zeros(n)
+    state, start = None, np.ones(n, bool)
+    if record is not None:
+        record(0, obs, alive)
+    for k in range(1, steps + 1):
+        action, state = policy.predict(policy_obs(policy, obs), state=state, episode_start=start,
+                                       deterministic=True)
+        start[:] = False
+        obs, rew, term, _, info = env.step(np.asarray(action, np.float32).reshape(-1, 1))
+        returns += np.where(alive, rew, 0.0)
+        for i in np.flatnonzero(term & alive):
+            ended[i] = info["termination"][i]
+        alive &= ~term
+        if record is not None:
+            record(k, obs, alive)
+    return returns, ended
 
 
 def policy_obs(policy, obs: np.ndarray) -> np.ndarray:

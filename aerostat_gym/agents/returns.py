@@ -12,7 +12,7 @@ import numpy as np
 
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..registration import MAX_EPISODE_STEPS, TASKS
-from .evaluate import policy_obs
+from .evaluate import rollout
 from .policies import load_policy
 from .protocol_stats import bootstrap_mean_ci, paired_difference_ci
 
@@ -32,15 +32,7 @@ def task_returns(policy_name: str, task_id: str, seeds=RETURN_SEEDS, params=None
     policy = load_policy(policy_name, params=params)
     env = TetheredAerostatVectorEnv(num_envs=len(seeds), observation="full", **kwargs)
     obs, _ = env.reset(seed=seeds)
-    total, alive = np.zeros(len(seeds)), np.ones(len(seeds), bool)
-    state, start = None, np.ones(len(seeds), bool)
-    for _ in range(MAX_EPISODE_STEPS):
-        action, state = policy.predict(policy_obs(policy, obs), state=state, episode_start=start,
-                                       deterministic=True)
-        start[:] = False
-        obs, reward, terminated, _, _ = env.step(np.asarray(action, np.float32).reshape(-1, 1))
-        total += np.where(alive, reward, 0.0)
-        alive &= ~terminated
+    total, _ = rollout(policy, env, obs, MAX_EPISODE_STEPS)
     env.close()
     return total
 
