@@ -153,7 +153,10 @@ class WinchParams:
     max_speed: float = _f("m/s", "ESTIMATE", POSITIVE, "reel speed limit")
     max_acceleration: float = _f("m/s^2", "ESTIMATE", POSITIVE, "reel acceleration limit")
     speed_time_constant: float = _f("s", "ESTIMATE", POSITIVE, "closed speed-loop time constant")
-    brake_speed: float = _f("m/s", "ESTIMATE", NONNEG, "set-points below this engage the brake")
+    brake_speed: float = _f("m/s", "ESTIMATE", NONNEG,
+                            "stand-still band: set-points below this count as 'stand still'")
+    brake_dwell: float = _f("s", "ESTIMATE", NONNEG,
+                            "the brake engages after the set-point stood still this long")
     brake_hold_speed: float = _f("m/s", "ESTIMATE", NONNEG,
                                  "drum speed below which the brake clamps (v_w set to 0)")
     min_length: float = _f("m", "ESTIMATE", POSITIVE, "shortest tether length")

@@ -24,7 +24,6 @@ from aerostat_gym.agents.frontier import (
     linear_fit_zeta,
     modal_linear_peak,
     swing_response,
-    swing_response_dwell,
 )
 from aerostat_gym.agents.lqg import LQGPolicy, LQGSchedule
 from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule
@@ -54,9 +53,10 @@ def baselines_at(params, U, swing):
     braked = float(lqr.designs[0].mode("pendulum", "braked").zeta)
     rows.append(_row("passive", "dead band", braked, swing_response(PassivePolicy(), U, swing)))
     pol = LQRPolicy(params, schedule=lqr)
-    for brake, run in (("dead band", swing_response(pol, U, swing)),
+    for brake, run in (("dead band", swing_response(pol, U, swing, brake_speed=0.02,
+                                                    brake_dwell=0.0)),
                        ("off", swing_response(pol, U, swing, brake_speed=0.0)),
-                       ("dwell", swing_response_dwell(pol, U, swing, params=params))):
+                       ("dwell", swing_response(pol, U, swing, params=params))):
         rows.append(_row("lqr", brake, pred, run, lin))
     lqg = LQGPolicy(params, schedule=LQGSchedule(params, speeds=np.array([U]),
                                                  obs_noise=LQG_NOISE))
@@ -77,7 +77,7 @@ def modal_curve_at(params, U, swing, zetas):
         lin = linear_fit_zeta(d.closed_loop_matrix, d.K_subset, dx0[d.index],
                               list(d.index).index(d.lqr.linear.layout.cm_pos.start))
         for brake, run in (("off", swing_response(pol, U, swing, brake_speed=0.0)),
-                           ("dwell", swing_response_dwell(pol, U, swing, params=params))):
+                           ("dwell", swing_response(pol, U, swing, params=params))):
             row = _row("modal", brake, z, run, lin)
             row["linear_peak_set_point_m_s"] = modal_linear_peak(sch.designs[0], dx0)
             rows.append(row)

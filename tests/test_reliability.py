@@ -172,12 +172,13 @@ def test_3_overhauled_drum_never_exceeds_its_rated_speed():
 def test_3_brake_rule_overhaul_closed_form():
     from aerostat_gym.sim.winch import brake_rule
 
+    # arguments: v, brake wanted, braked, v_w, max_speed, hold_speed, tension, max_force
     # over-hauled, reel-in: brake sets at once, even at speed
-    assert brake_rule(-1.0, False, False, 0.8, 1.0, 0.02, 0.02, 9000.0, 8000.0) == (0.0, True, 0.0)
+    assert brake_rule(-1.0, False, False, 0.8, 1.0, 0.02, 9000.0, 8000.0) == (0.0, True, 0.0)
     # over-hauled, pay-out: obeyed (the drum speed is capped at the rating)
-    assert brake_rule(0.5, False, False, 1.7, 1.0, 0.02, 0.02, 9000.0, 8000.0) == (0.5, False, 1.0)
+    assert brake_rule(0.5, False, False, 1.7, 1.0, 0.02, 9000.0, 8000.0) == (0.5, False, 1.0)
     # within the motor's force: the old rule (reel-in released)
-    assert brake_rule(-1.0, False, True, 0.0, 1.0, 0.02, 0.02, 7000.0, 8000.0) == (-1.0, False, 0.0)
+    assert brake_rule(-1.0, False, True, 0.0, 1.0, 0.02, 7000.0, 8000.0) == (-1.0, False, 0.0)
 
 
 # --- 4. feasibility across sections ---------------------------------------------------------------

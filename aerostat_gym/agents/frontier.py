@@ -8,14 +8,11 @@ seconds. The pendulum damping ratio is fitted to the along-wind CM displacement
 (:func:`aerostat_gym.agents.metrics.fit_damped_sinusoid`); the peak reel speed and the peak
 set-point come from the winch state and the action.
 
-Brake logic. The shipped winch engages its brake whenever |v_set| < winch.brake_speed
-(0.02 m/s), which swallows the small commands of a linear controller near the end of a swing
-(and all of them at a 0.5-1 m swing). ``brake_speed=0`` turns this dead band off, which is what
-a dwell-time brake (:func:`aerostat_gym.winch_dwell.dwell_brake_rule`: engage only after the
-command has stayed near zero for a dwell time) does for a controller whose command keeps
-moving. :func:`swing_response_dwell` runs the dwell-time rule itself, through
-:func:`aerostat_gym.simulation.simulate` (the environment's compiled step still applies the
-shipped rule), for policies that read the privileged full observation.
+Brake logic: the winch's own (:func:`aerostat_gym.sim.winch.brake_wanted`): the brake is
+applied on an exact-zero set-point or after ``winch.brake_dwell`` (10 s) inside the stand-still
+band ``winch.brake_speed`` (0.002 m/s), so a controller's small commands reach the drum.
+``brake_speed`` and ``brake_dwell`` override those two parameters for a run (``brake_speed=0``:
+only an exact zero brakes; ``brake_speed=0.02, brake_dwell=0``: the dead band of 0.2).
 """
 
 from __future__ import annotations
@@ -26,12 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..envs.vector import TetheredAerostatVectorEnv
-from ..params import apply_overrides, load_params
-from ..physics.state import StateLayout
-from ..sim import simulate
-from ..sim.winch_dwell import DEFAULT_DWELL_TIME, DEFAULT_STANDSTILL_BAND, DwellBrake
 from .evaluate import policy_obs
-from .lqr import set_point_law
 from .metrics import fit_damped_sinusoid
 from .metrics_drift import fit_pendulum_with_drift
 from .modal import design_modal
@@ -105,11 +97,23 @@ class SwingRun:
                 "length_wander_m": self.length_wander, "ended": self.ended}
 
 
+def brake_overrides(brake_speed: float | None = None, brake_dwell: float | None = None
+                    ) -> dict | None:
+    """Parameter overrides of the winch's brake logic (None where neither is given)."""
+    out = {}
+    if brake_speed is not None:
+        out["winch.brake_speed"] = float(brake_speed)
+    if brake_dwell is not None:
+        out["winch.brake_dwell"] = float(brake_dwell)
+    return out or None
+
+
 def swing_env(wind_speed: float, swing: float, brake_speed: float | None = None,
               obs_noise: float = 0.0, params=None, control_step: float = 0.2,
-              duration: float = 180.0, num_envs: int = 1) -> TetheredAerostatVectorEnv:
+              duration: float = 180.0, num_envs: int = 1, brake_dwell: float | None = None
+              ) -> TetheredAerostatVectorEnv:
     """The vector environment of a swing-recovery run (full observation, steady wind)."""
-    overrides = None if brake_speed is None else {"winch.brake_speed": float(brake_speed)}
+    overrides = brake_overrides(brake_speed, brake_dwell)
     return TetheredAerostatVectorEnv(
         num_envs=num_envs, max_episode_steps=int(round(duration / control_step)),
         observation="full", control_step=control_step, turbulence="none",
@@ -119,8 +123,8 @@ def swing_env(wind_speed: float, swing: float, brake_speed: float | None = None,
 
 
 def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: float | None = None,
-                   obs_noise: float = 0.0, seed: int = 0, params=None, duration: float = 180.0,
-                   control_step: float = 0.2) -> SwingRun:
+                   brake_dwell: float | None = None, obs_noise: float = 0.0, seed: int = 0,
+                   params=None, duration: float = 180.0, control_step: float = 0.2) -> SwingRun:
     """Run ``policy`` through one swing recovery and fit its pendulum damping.
 
     Parameters
@@ -131,8 +135,8 @@ def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: floa
         Mean wind speed [m/s].
     swing : float
         Initial along-wind swing of aerostat and tether [m].
-    brake_speed : float or None
-        Override of winch.brake_speed (None: the shipped 0.02 m/s dead band; 0: off).
+    brake_speed, brake_dwell : float or None
+        Overrides of winch.brake_speed and winch.brake_dwell (None: the configured brake logic).
     obs_noise : float
         Sensor noise std in the environment's scaled units.
     seed : int
@@ -150,14 +154,15 @@ def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: floa
     """
     if not (math.isfinite(swing) and swing > 0):
         raise ValueError(f"swing must be finite and > 0 [m], got {swing!r}")
-    env = swing_env(wind_speed, swing, brake_speed, obs_noise, params, control_step, duration)
+    env = swing_env(wind_speed, swing, brake_speed, obs_noise, params, control_step, duration,
+                    brake_dwell=brake_dwell)
     obs, _ = env.reset(seed=[seed], options={"wind_speed": [wind_speed]})
     b, lay = env.batch, env.batch.layout
     vmax = float(b.params.winch.max_speed)
     ix, iL, iv = lay.cm_pos.start, lay.winch_length, lay.winch_speed
     steps = env.max_episode_steps
     x, L, v, sp = (np.zeros(steps + 1) for _ in range(4))
-    x[0], L[0], v[0] = (b.state[0, ix] - b.trim_state[0, ix], b.state[0, iL] - b.trim_state[0, iL], b.state[0, iv])
+    x[0], L[0], v[0] = _sample(b, ix, iL, iv)
     state, start, ended, k_end = None, np.ones(1, bool), None, steps
     for k in range(1, steps + 1):
         action, state = policy.predict(policy_obs(policy, obs), state=state, episode_start=start,
@@ -166,7 +171,7 @@ def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: floa
         a = np.asarray(action, np.float32).reshape(-1, 1)
         sp[k - 1] = float(np.clip(a[0, 0], -1.0, 1.0)) * vmax
         obs, _, term, trunc, info = env.step(a)
-        x[k], L[k], v[k] = (b.state[0, ix] - b.trim_state[0, ix], b.state[0, iL] - b.trim_state[0, iL], b.state[0, iv])
+        x[k], L[k], v[k] = _sample(b, ix, iL, iv)
         if term[0]:
             ended, k_end = str(info["termination"][0]), k
             break
@@ -176,6 +181,12 @@ def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: floa
     drift = fit_pendulum_with_drift(t, x[:k_end + 1])
     return SwingRun(float(wind_speed), float(swing), t, x[:k_end + 1], L[:k_end + 1],
                     v[:k_end + 1], sp[:k_end], fit.zeta, fit.period, fit.r2, ended, drift.zeta)
+
+
+def _sample(b, ix: int, iL: int, iv: int) -> tuple[float, float, float]:
+    """(along-wind CM displacement, length deviation, reel speed) of slot 0 of a batch."""
+    return (b.state[0, ix] - b.trim_state[0, ix], b.state[0, iL] - b.trim_state[0, iL],
+            b.state[0, iv])
 
 
 def initial_state(wind_speed: float, swing: float, params=None) -> tuple[np.ndarray, np.ndarray]:
@@ -191,55 +202,6 @@ def initial_deviation(wind_speed: float, swing: float, params=None) -> np.ndarra
     """The environment's start of a swing-recovery run as a deviation from trim (6n+8)."""
     x0, xt = initial_state(wind_speed, swing, params)
     return x0 - xt
-
-
-def swing_response_dwell(policy, wind_speed: float, swing: float, *,
-                         dwell: float = DEFAULT_DWELL_TIME,
-                         band: float = DEFAULT_STANDSTILL_BAND,
-                         params=None, duration: float = 180.0,
-                         control_step: float = 0.2) -> SwingRun:
-    """:func:`swing_response` with the dwell-time brake logic, for a full-observation policy.
-
-    Parameters
-    ----------
-    policy : object
-        A policy reading the privileged full observation (wind speed at index 19, x - x_trim
-        from index 20), e.g. :class:`~aerostat_gym.agents.lqr.LQRPolicy`.
-    wind_speed : float
-        Mean wind speed [m/s].
-    swing : float
-        Initial along-wind swing [m].
-    dwell : float
-        Stand-still time before the brake is applied [s].
-    band : float
-        Stand-still band of the set-point [m/s] (default 0.002, the proposal).
-    params : Params or None
-        Parameters (default: the shipped baseline).
-    duration : float
-        Length of the run [s].
-    control_step : float
-        Control step [s] (the policy's and the winch logic's rate).
-
-    Returns
-    -------
-    SwingRun
-        With the semi-implicit integrator, as the environment uses.
-    """
-    params = params or load_params()
-    x0, xt = initial_state(wind_speed, swing, params)
-    lay = StateLayout(params.tether.n_elements)
-    set_points: list = []
-    u = set_point_law(policy, xt, wind_speed, params, DwellBrake(band, control_step, dwell),
-                      set_points)
-    tr = simulate(apply_overrides(params, {"winch.brake_speed": 0.0}), x0, duration,
-                  wind=wind_speed, integrator="semi-implicit", output_dt=control_step, u=u)
-    x = tr.cm_pos[:, 0] - xt[lay.cm_pos.start]
-    fit = fit_damped_sinusoid(tr.time, x)
-    drift = fit_pendulum_with_drift(tr.time, x)
-    return SwingRun(float(wind_speed), float(swing), tr.time, x,
-                    tr.length - xt[lay.winch_length], tr.reel_speed, np.array(set_points),
-                    fit.zeta, fit.period, fit.r2, None if tr.status == "ok" else tr.status,
-                    drift.zeta)
 
 
 def linear_response(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, steps: int

@@ -38,7 +38,7 @@ RESTORE_PENDULUM_PERIODS = 60.0 / 43.64
 
 
 class PassivePolicy:
-    """The braked winch: action 0 (below the brake dead band)."""
+    """The braked winch: action 0 (an exact-zero set-point applies the brake at once)."""
 
     obs_dim = N_OBS
 

@@ -118,6 +118,7 @@ class EnvBatch:
         self.action = np.zeros(N)  # action of the step in [-1, 1]
         self.action_prev = np.zeros(N)
         self.braked = np.zeros(N, dtype=np.bool_)  # the brake holds the drum
+        self.quiet = np.zeros(N)  # time the set-point has stood still (brake dwell clock) [s]
         self._clipped = np.zeros(N, dtype=np.bool_)
         self.packed = np.zeros((N, P_SIZE))  # packed parameters (randomised per episode)
         self.wind = np.zeros((N, W_SIZE))  # packed wind vector (mean, gust, field grid)
@@ -164,6 +165,7 @@ class EnvBatch:
         cfg[K.C_GROUND] = params.aerostat.diameter
         cfg[K.C_BRAKE_SPEED] = w.brake_speed
         cfg[K.C_HOLD_SPEED] = w.brake_hold_speed
+        cfg[K.C_BRAKE_DWELL] = w.brake_dwell
         cfg[K.C_SWL] = w.safe_working_load
         cfg[K.C_FULL] = 1.0 if self.full_size else 0.0
         cfg[K.C_HORIZON] = math.inf  # the periodic field serves any episode length
@@ -185,6 +187,7 @@ class EnvBatch:
         self.time[i] = 0.0
         self.action[i] = self.action_prev[i] = 0.0
         self.braked[i] = False
+        self.quiet[i] = 0.0
         self.code[i] = RUNNING
         self.peak[i] = 0.0
         self.episodes[i] = ep
@@ -204,7 +207,8 @@ class EnvBatch:
 
     #: Per-slot arrays that make up the simulator state of one environment.
     SLOT_ARRAYS = ("state", "trim_state", "trim_tension", "time", "action", "action_prev",
-                   "braked", "packed", "wind", "field_index", "obs", "terms", "code", "peak")
+                   "braked", "quiet", "packed", "wind", "field_index", "obs", "terms", "code",
+                   "peak")
 
     def get_slot(self, i: int) -> dict:
         """A copy of everything that determines slot i's future (see :meth:`set_slot`)."""
@@ -249,7 +253,7 @@ class EnvBatch:
 
     def _arrays(self) -> tuple:
         return (self.state, self.state_prev, self.time, self.action, self.action_prev,
-                self.braked, self.packed, self.wind, self.bank, self.field_index, self.work,
+                self.braked, self.quiet, self.packed, self.wind, self.bank, self.field_index, self.work,
                 self.cfg, self.trim_state, self.trim_tension, self.scale, self.low64, self.high64,
                 self.obs, self.terms, self.code, self.peak)
 

@@ -40,7 +40,8 @@ class TetheredAerostatEnv(gym.Env):
     Frames and signs: inertial X, Y, Z with Z up and the winch at the origin; the mean wind
     blows along +X, so at trim the aerostat flies downwind (X > 0) with its nose into the wind
     (yaw psi = pi). Attitude is the Z-Y-X Euler triple (roll phi, pitch theta, yaw psi;
-    theta < 0 is nose up, so a positive pitch observation is nose down); body rates p, q, r about the body x (nose), y, z axes. A positive reel speed
+    theta < 0 is nose up, so a positive pitch observation is nose down); body rates p, q, r
+    about the body x (nose), y, z axes. A positive reel speed
     pays line out. SI units throughout.
 
     ## Action Space
@@ -48,8 +49,9 @@ class TetheredAerostatEnv(gym.Env):
     ``Box(-1, 1, (1,), float32)``: the winch reel-speed set-point as a fraction of the winch's
     maximum speed (``winch.max_speed``, 1 m/s by default); positive pays out. The winch's
     speed loop (time constant, acceleration and motor-force limits) follows the set-point;
-    set-points below ``winch.brake_speed`` engage the brake, which clamps the drum once it has
-    slowed down (so action 0 is the passive, braked winch). Over-hauled (the tether tension
+    the brake engages on an exact-zero set-point (so action 0 is the passive, braked winch) or
+    once the set-point has stayed below ``winch.brake_speed`` (0.002 m/s) for
+    ``winch.brake_dwell`` (10 s), and clamps the drum once it has slowed down. Over-hauled (the tether tension
     above the motor's force limit, ``winch.max_motor_force``, from about 27 m/s with the
     baseline), the winch sets its holding brake against reel-in and hold commands and pays out
     no faster than ``winch.max_speed`` on pay-out commands. Out-of-range actions are clipped

@@ -44,7 +44,7 @@ from ..physics.state import (
 )
 from ..physics.wind import W_UREF, air_velocity
 from ..sim import events as E
-from ..sim.winch import brake_rule
+from ..sim.winch import brake_rule, brake_wanted
 from . import reward as R
 from . import spaces as S
 
@@ -57,13 +57,14 @@ C_RK4_SAFETY = SCHEME_RK4_SAFETY
 C_SI_DT = SCHEME_SI_DT
 C_DT = SCHEME_SIZE  # control step [s]
 C_GROUND = C_DT + 1  # ground-strike height of the CM [m] (one hull diameter)
-C_BRAKE_SPEED = C_DT + 2  # set-points below this engage the brake [m/s]
+C_BRAKE_SPEED = C_DT + 2  # stand-still band of the set-point [m/s]
 C_HOLD_SPEED = C_DT + 3  # the brake clamps the drum below this reel speed [m/s]
 C_SWL = C_DT + 4  # safe working load [N]
 C_FULL = C_DT + 5  # 1: append the privileged full state to the observation
 C_HORIZON = C_DT + 6  # the turbulence field covers up to this time [s]
 C_FMAX = C_DT + 7  # the winch motor's force limit at the line [N] (over-haul detection)
-C_WEIGHTS = C_DT + 8  # reward weights in reward.REWARD_TERMS order
+C_BRAKE_DWELL = C_DT + 8  # the brake engages after this long inside the stand-still band [s]
+C_WEIGHTS = C_DT + 9  # reward weights in reward.REWARD_TERMS order
 C_SIZE = C_WEIGHTS + len(R.REWARD_TERMS)
 
 _JIT = {"cache": True, "error_model": "numpy", "fastmath": FASTMATH}
@@ -130,19 +131,22 @@ def observe(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs):
 
 
 @njit(**_JIT)
-def _step_one(x, x_prev, t, a, a_prev, braked, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi,
-              obs, terms):
-    """One control step of one environment; returns (outcome code, brake state, peak tension).
+def _step_one(x, x_prev, t, a, a_prev, braked, quiet, p, wp, wf, w, cfg, x_trim, T_trim, scale,
+              lo, hi, obs, terms):
+    """One control step of one environment; returns (outcome code, brake state, stand-still
+    time, peak tension).
 
     a is the action in [-1, 1] (already clipped): set-point a * v_max through the winch's
-    brake rule, which reads the winch tension of the start state from the work array (filled
-    by the observation of that state). On a non-finite state or non-finite outputs the state
+    brake logic (:func:`aerostat_gym.sim.winch.brake_wanted`, then ``brake_rule``, which reads
+    the winch tension of the start state from the work array, filled by the observation of
+    that state). On a non-finite state or non-finite outputs the state
     is restored to the start of the step, so the observation stays finite, and the outcome is
     NONFINITE or NONFINITE_OUTPUT; a finite state beyond physical bounds is DIVERGED.
     """
     iv = aerostat_offset(int(p[P_NEL])) + S_REEL
-    v_set, brake, v_w = brake_rule(a * p[P_W_VMAX], False, braked, x[iv], p[P_W_VMAX],
-                                   cfg[C_BRAKE_SPEED], cfg[C_HOLD_SPEED],
+    v = a * p[P_W_VMAX]
+    want, quiet = brake_wanted(v, False, quiet, cfg[C_DT], cfg[C_BRAKE_SPEED], cfg[C_BRAKE_DWELL])
+    v_set, brake, v_w = brake_rule(v, want, braked, x[iv], p[P_W_VMAX], cfg[C_HOLD_SPEED],
                                    winch_tension(x, p, w), cfg[C_FMAX])
     x[iv] = v_w
     u = np.empty(2)
@@ -156,10 +160,10 @@ def _step_one(x, x_prev, t, a, a_prev, braked, p, wp, wf, w, cfg, x_trim, T_trim
     t1 = t + cfg[C_DT]
     if status == NONFINITE:
         return _failed(E.NONFINITE, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo,
-                       hi, obs, terms), brake, 0.0
+                       hi, obs, terms), brake, quiet, 0.0
     if not math.isfinite(observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)):
         return _failed(E.NONFINITE_OUTPUT, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim,
-                       scale, lo, hi, obs, terms), brake, 0.0
+                       scale, lo, hi, obs, terms), brake, quiet, 0.0
     code = E.step_outcome(x, t1, p, stats[0], cfg[C_GROUND], cfg[C_HORIZON])
     if code == E.TETHER_BREAK or code == E.GROUND_STRIKE or code == E.LENGTH_LIMIT:
         if not _confirmed(code, x, stats[0], x_prev, t, u, p, wp, wf, w, cfg):
@@ -167,9 +171,9 @@ def _step_one(x, x_prev, t, a, a_prev, braked, p, wp, wf, w, cfg, x_trim, T_trim
         observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)  # refill w
     if code == E.DIVERGED:
         return _failed(code, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi,
-                       obs, terms), brake, 0.0
+                       obs, terms), brake, quiet, 0.0
     R.reward_terms(obs, a, a_prev, stats[0], code, cfg[C_WEIGHTS:], cfg[C_SWL], terms)
-    return code, brake, stats[0]
+    return code, brake, quiet, stats[0]
 
 
 #: [-] a terminating step is physical when half the integration step reproduces its end state
@@ -220,37 +224,39 @@ def _failed(code, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, parallel=True)
-def step_parallel(active, state, state_prev, time, action, action_prev, braked, packed, wind,
-                  bank, field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs,
-                  terms, code, peak):
+def step_parallel(active, state, state_prev, time, action, action_prev, braked, quiet, packed,
+                  wind, bank, field_index, work, cfg, trim_state, trim_tension, scale, lo, hi,
+                  obs, terms, code, peak):
     """Step every environment i with active[i] (parallel over environments)."""
     for i in prange(state.shape[0]):
         if active[i]:
-            _step_slot(i, state, state_prev, time, action, action_prev, braked, packed, wind,
-                       bank, field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs,
-                       terms, code, peak)
+            _step_slot(i, state, state_prev, time, action, action_prev, braked, quiet, packed,
+                       wind, bank, field_index, work, cfg, trim_state, trim_tension, scale, lo,
+                       hi, obs, terms, code, peak)
 
 
 @njit(**_JIT)
-def step_serial(state, state_prev, time, action, action_prev, braked, packed, wind, bank,
-                field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs, terms, code,
-                peak):
+def step_serial(state, state_prev, time, action, action_prev, braked, quiet, packed, wind,
+                bank, field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs, terms,
+                code, peak):
     """The same step for one environment (index 0), without the thread pool."""
-    _step_slot(0, state, state_prev, time, action, action_prev, braked, packed, wind, bank,
-               field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs, terms, code,
-               peak)
+    _step_slot(0, state, state_prev, time, action, action_prev, braked, quiet, packed, wind,
+               bank, field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs, terms,
+               code, peak)
 
 
 @njit(**{**_JIT, "inline": "always"})
-def _step_slot(i, state, state_prev, time, action, action_prev, braked, packed, wind, bank,
-               field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs, terms, code,
-               peak):
-    """Step slot i of the batch arrays and advance its clock and action memory."""
-    c, br, pk = _step_one(state[i], state_prev[i], time[i], action[i], action_prev[i], braked[i],
-                          packed[i], wind[i], bank[field_index[i]], work[i], cfg, trim_state[i],
-                          trim_tension[i], scale, lo, hi, obs[i], terms[i])
+def _step_slot(i, state, state_prev, time, action, action_prev, braked, quiet, packed, wind,
+               bank, field_index, work, cfg, trim_state, trim_tension, scale, lo, hi, obs, terms,
+               code, peak):
+    """Step slot i of the batch arrays and advance its clock, winch logic and action memory."""
+    c, br, qt, pk = _step_one(state[i], state_prev[i], time[i], action[i], action_prev[i],
+                              braked[i], quiet[i], packed[i], wind[i], bank[field_index[i]],
+                              work[i], cfg, trim_state[i], trim_tension[i], scale, lo, hi, obs[i],
+                              terms[i])
     code[i] = c
     braked[i] = br
+    quiet[i] = qt
     peak[i] = pk
     time[i] += cfg[C_DT]
     action_prev[i] = action[i]

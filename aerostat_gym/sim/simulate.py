@@ -108,7 +108,7 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
     n_out = max(1, int(round(duration / output_dt)))
     if model.wf.shape[1] > 1:  # a turbulence field must cover the whole run (clear error if not)
         check_covers(model.wp, model.wf, n_out * output_dt)
-    winch = WinchController(model.params)
+    winch = WinchController(model.params, output_dt)  # the stand-still clock ticks per interval
     times, states, tens, ends = [0.0], [x.copy()], [model.tensions(x)], [model.end_tensions(x)]
     status, events, cmds = "ok", [], []
     for k in range(n_out):

@@ -9,9 +9,11 @@ holds what a winch's supervisory controller does between control steps, so that
 
 - set-point validation: a NaN or infinite set-point is an error (:class:`WinchInputError`,
   naming the value); a set-point beyond +-max_speed is clipped and counted;
-- the brake rule: the brake engages when commanded, or when |v_set| < ``brake_speed``; it
-  clamps the drum only once |v_w| <= ``brake_hold_speed`` (v_w is then set to exactly 0). Until
-  then the speed loop decelerates the drum toward zero at its acceleration limit;
+- the brake rule (:func:`brake_wanted`, :func:`brake_rule`): the brake is wanted when
+  commanded, when the set-point is exactly 0, or when |v_set| has stayed below ``brake_speed``
+  (the stand-still band) for ``brake_dwell`` seconds; it clamps the drum only once
+  |v_w| <= ``brake_hold_speed`` (v_w is then set to exactly 0). Until then the speed loop
+  decelerates the drum toward zero at its acceleration limit;
 - the load cell (winch-end tether tension, noise-free for now);
 - tether mass bookkeeping: mass aloft mu L, mass on the drum mu (total_line_length - L);
 - events with their thresholds: ``winch_slack`` (load cell below ``slack_tension``),
@@ -105,24 +107,57 @@ def parse_command(u) -> tuple[float, bool]:
 
 
 @njit(cache=True)
-def brake_rule(v, brake_cmd, braked, v_w, max_speed, brake_speed, hold_speed,
-               tension=0.0, max_force=np.inf):
-    """One control step of the winch's supervisory logic; returns (v_set, brake, v_w).
+def brake_wanted(v, brake_cmd, quiet, dt, band, dwell):
+    """The supervisory brake request of one control step; returns (wanted, quiet).
+
+    Parameters
+    ----------
+    v : float
+        Requested set-point [m/s].
+    brake_cmd : bool
+        The brake is commanded explicitly.
+    quiet : float
+        Time the set-point has stayed inside the stand-still band before this step [s].
+    dt : float
+        Control step [s].
+    band : float
+        Stand-still band: |v| below this counts as "stand still" [m/s] (``winch.brake_speed``).
+    dwell : float
+        Stand-still time after which the brake is applied [s] (``winch.brake_dwell``).
+
+    Notes
+    -----
+    A real winch's parking brake is applied by its supervisory logic once the drive has been
+    asked to stand still for a while, not at every small command. A linear controller's
+    set-point passes through any band around zero twice per pendulum period and stays inside
+    it for the whole tail of a small swing; braking there at once would swallow those
+    commands. So the brake is wanted when it is commanded, when the set-point is exactly 0 (the
+    environment's action 0, the passive braked winch), or when |v| has stayed below ``band``
+    for at least ``dwell`` seconds (``quiet`` counts that time, including this step, and
+    restarts at 0 whenever |v| >= band). With ``dwell = 0`` any set-point inside the band
+    brakes at once (the dead-band rule of aerostat-gym 0.2).
+    """
+    quiet = quiet + dt if abs(v) < band else 0.0
+    want = brake_cmd or v == 0.0 or (abs(v) < band and quiet >= dwell - 1e-9)
+    return want, quiet
+
+
+@njit(cache=True)
+def brake_rule(v, want, braked, v_w, max_speed, hold_speed, tension=0.0, max_force=np.inf):
+    """One control step of the winch's brake and set-point logic; returns (v_set, brake, v_w).
 
     Parameters
     ----------
     v : float
         Requested reel-out speed [m/s].
-    brake_cmd : bool
-        The brake is commanded.
+    want : bool
+        The brake is wanted (:func:`brake_wanted`).
     braked : bool
         The brake held the drum over the last step.
     v_w : float
         Drum (reel-out) speed at the start of the step [m/s].
     max_speed : float
         Rated drum speed [m/s].
-    brake_speed : float
-        Set-points below this engage the brake [m/s].
     hold_speed : float
         The brake clamps the drum once it is this slow [m/s].
     tension : float
@@ -132,9 +167,9 @@ def brake_rule(v, brake_cmd, braked, v_w, max_speed, brake_speed, hold_speed,
 
     Notes
     -----
-    The brake is wanted when commanded or when |v| < brake_speed. It clamps the drum (v_w set to
-    exactly 0) if it already held it or once |v_w| <= hold_speed; until then the speed loop
-    decelerates the drum with set-point 0. Released, the set-point is clipped to +-max_speed.
+    Wanted, the brake clamps the drum (v_w set to exactly 0) if it already held it or once
+    |v_w| <= hold_speed; until then the speed loop decelerates the drum with set-point 0.
+    Released, the set-point is clipped to +-max_speed.
 
     Over-hauled (the line tension above the motor's force limit, so the motor cannot hold the
     load), a ground winch does not let the load run the drum out against a reel-in or hold
@@ -147,9 +182,9 @@ def brake_rule(v, brake_cmd, braked, v_w, max_speed, brake_speed, hold_speed,
     Compiled so the environment's compiled step applies the same rule.
     """
     v_w = min(max(v_w, -max_speed), max_speed)
-    if tension > max_force and (brake_cmd or v < brake_speed):
+    if tension > max_force and (want or v <= 0.0):
         return 0.0, True, 0.0
-    if brake_cmd or abs(v) < brake_speed:
+    if want:
         if braked or abs(v_w) <= hold_speed:
             return 0.0, True, 0.0
         return 0.0, False, v_w
@@ -167,11 +202,16 @@ class WinchController:
     ----------
     n_steps, n_clipped : control steps taken and steps whose set-point was clipped.
     braked : whether the brake holds the drum (after the last :meth:`command`).
+    quiet : time the set-point has stayed inside the stand-still band [s].
+    dt : control step [s] (the stand-still clock's tick).
     thresholds : :class:`WinchThresholds`.
     """
 
-    def __init__(self, params: Params | None = None):
-        self.params = params or load_params()  # total_line_length >= max_length checked at load
+    def __init__(self, params: Params | None = None, dt: float = 0.2):
+        self.params = params or load_params()
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+            raise ValueError(f"winch control step dt must be a finite number > 0, got {dt!r}")
+        self.dt = float(dt)  # total_line_length >= max_length checked at load
         self.layout = StateLayout(self.params.tether.n_elements)
         self.mu = self.params.derived.mass_per_length
         self.thresholds = WinchThresholds.from_params(self.params)
@@ -181,6 +221,7 @@ class WinchController:
         self.n_steps = 0
         self.n_clipped = 0
         self.braked = False
+        self.quiet = 0.0
         self._slack = False
         self._over = False
 
@@ -190,7 +231,8 @@ class WinchController:
         """Validate and apply one command ``u`` (v_set or [v_set, brake]) at state ``x``, with
         the load-cell ``tension`` [N] of that state (over-haul hold, see :func:`brake_rule`).
 
-        Brake rule: wanted when commanded or when |v_set| < brake_speed. If the drum is slow
+        Brake rule (:func:`brake_wanted`): wanted when commanded, on an exact-zero set-point,
+        or once |v_set| has stayed below brake_speed for brake_dwell seconds. If the drum is slow
         enough (|v_w| <= brake_hold_speed) the brake clamps: ``x[v_w]`` is set to exactly 0 (in
         place) and the core holds L fixed. Otherwise the speed loop decelerates the drum with
         set-point 0 and the brake is tried again at the next step. Released, the set-point is
@@ -202,9 +244,10 @@ class WinchController:
         self.n_steps += 1
         self.n_clipped += int(clipped)
         iv = self.layout.winch_speed
-        v_set, brake, v_w = brake_rule(v, brake_cmd, self.braked, x[iv], w.max_speed,
-                                       w.brake_speed, w.brake_hold_speed, float(tension),
-                                       w.max_motor_force)
+        want, self.quiet = brake_wanted(v, brake_cmd, self.quiet, self.dt, w.brake_speed,
+                                        w.brake_dwell)
+        v_set, brake, v_w = brake_rule(v, want, self.braked, x[iv], w.max_speed,
+                                       w.brake_hold_speed, float(tension), w.max_motor_force)
         clamped = brake and not self.braked
         x[iv] = v_w  # exactly 0 once the brake holds the drum
         self.braked = brake
