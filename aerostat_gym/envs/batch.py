@@ -171,6 +171,8 @@ class EnvBatch:
         cfg[K.C_HORIZON] = math.inf  # the periodic field serves any episode length
         cfg[K.C_FMAX] = w.max_motor_force
         cfg[K.C_WEIGHTS:] = t.resolved["weights"]
+        cfg[K.C_LENGTH_BAND] = (reward.LENGTH_BAND_FRACTION * params.tether.length
+                                / spaces.CHANNELS[spaces.OBS_DLENGTH].scale)
         return cfg
 
     # --- episodes --------------------------------------------------------------------------

@@ -85,14 +85,17 @@ class TetheredAerostatEnv(gym.Env):
 
     ## Rewards
 
-    The reward is the sum of named non-positive terms, each in ``info["reward_<name>"]``
-    (so ``reward == sum`` of them to float precision), with weights from ``reward_weights``:
-    displacement ``-w (dx^2+dy^2)`` and velocity ``-w (vx^2+vy^2)`` in the scaled channels
-    above (horizontal: the blow-by swing; the winch's own reeling moves the aerostat vertically); pitch ``-w dpitch^2``; pitch_rate ``-w q^2``; effort ``-w a^2``;
+    The reward is the winch-control score (:mod:`aerostat_gym.envs.reward`; the evaluator's
+    suite score is the mean episode return): the sum of named non-positive terms, each in
+    ``info["reward_<name>"]`` (so ``reward == sum`` of them to float precision), with weights
+    from ``reward_weights``: displacement ``-w (dx^2+dy^2)`` and velocity ``-w (vx^2+vy^2)`` in
+    the scaled channels above (horizontal: the blow-by swing; the winch's own reeling moves the
+    aerostat vertically); pitch ``-w dpitch^2``; pitch_rate ``-w q^2``; effort ``-w a^2``;
     effort_rate ``-w (a - a_prev)^2``; over_tension ``-w max(0, T_peak / SWL - 1)`` with the
     peak element tension over the step and the winch's safe working load; termination ``-w``
-    on a terminating step; length ``-w dlength^2`` (channel 14), which keeps the winch near its
-    trim length on average. Defaults: ``aerostat_gym.envs.DEFAULT_WEIGHTS``.
+    on a terminating step; length ``-w max(0, |dlength| - band)^2`` (channel 14, band 5 % of
+    the tether length: the length may wander 15 m for free on the baseline). Defaults:
+    ``aerostat_gym.envs.DEFAULT_WEIGHTS``.
 
     The reward is swappable (:mod:`aerostat_gym.envs.reward`): ``reward_fn=f`` replaces it by
     ``f(obs, action, info)``, called after each step with the new observation, the applied

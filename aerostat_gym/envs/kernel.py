@@ -64,7 +64,8 @@ C_FULL = C_DT + 5  # 1: append the privileged full state to the observation
 C_HORIZON = C_DT + 6  # the turbulence field covers up to this time [s]
 C_FMAX = C_DT + 7  # the winch motor's force limit at the line [N] (over-haul detection)
 C_BRAKE_DWELL = C_DT + 8  # the brake engages after this long inside the stand-still band [s]
-C_WEIGHTS = C_DT + 9  # reward weights in reward.REWARD_TERMS order
+C_LENGTH_BAND = C_DT + 9  # free band of the reward's length term (scaled length channel)
+C_WEIGHTS = C_DT + 10  # reward weights in reward.REWARD_TERMS order
 C_SIZE = C_WEIGHTS + len(R.REWARD_TERMS)
 
 _JIT = {"cache": True, "error_model": "numpy", "fastmath": FASTMATH}
@@ -172,7 +173,8 @@ def _step_one(x, x_prev, t, a, a_prev, braked, quiet, p, wp, wf, w, cfg, x_trim,
     if code == E.DIVERGED:
         return _failed(code, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi,
                        obs, terms), brake, quiet, 0.0
-    R.reward_terms(obs, a, a_prev, stats[0], code, cfg[C_WEIGHTS:], cfg[C_SWL], terms)
+    R.reward_terms(obs, a, a_prev, stats[0], code, cfg[C_WEIGHTS:], cfg[C_SWL],
+                   cfg[C_LENGTH_BAND], terms)
     return code, brake, quiet, stats[0]
 
 
