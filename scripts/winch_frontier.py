@@ -1,120 +1,178 @@
-"""Frontier figures of the winch baselines: pendulum damping ratio against peak reel speed at 5, 10
-and 15 m/s for the passive (braked) winch, the LQR, the LQG and the modal controller's curve,
-measured in the environment (swing recovery, steady wind) next to each design's linear value.
+"""Frontier of the winch policies: pendulum damping ratio against peak reel speed at 5, 10 and
+15 m/s for the passive (braked) winch, tension feedback, the LQR, the LQG, the modal
+controller's curve and the learned policies, measured in the environment (swing recovery,
+steady wind, the shipped winch and its brake logic), with the modal line's linear end at the
+winch's speed limit.
 
 Usage::
 
-    PYTHONPATH=. python scripts/winch_frontier.py [--swing 10] [--json out.json]
+    PYTHONPATH=. python scripts/winch_frontier.py [--swing 10] [--policy shipped ...]
+        [--json docs/figures/frontier.json] [--plot docs/figures/frontier.png]
 
-Brake logic per row: "dead band" is the shipped rule (brake below 0.02 m/s), "off" the dead band
-removed (winch.brake_speed = 0), "dwell" the dwell-time rule (brake after 10 s inside a 0.002 m/s
-stand-still band) run through simulate() (full-state policies only). The LQG reads the standard observation with sensor noise
-obs_noise = 0.01 (scaled units) and its filter is designed for that noise.
+Every run uses the full-state environment without sensor noise except the LQG, which reads the
+standard observation with sensor noise LQG_NOISE (scaled units, seed LQG_SEED), the noise its
+filter is designed for. Learned policies (``--policy``, repeatable: a name for
+:func:`aerostat_gym.agents.policies.load_policy` or a path to an SB3 .zip; default the shipped
+PPO) run deterministically on the noise-free observation they were trained for.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import time
+from pathlib import Path
 
 import numpy as np
 
 from aerostat_gym.agents.frontier import (
+    frontier_table,
     initial_deviation,
     linear_fit_zeta,
-    modal_linear_peak,
+    modal_peak_limit,
+    plot_frontier,
+    saturated_speeds,
     swing_response,
 )
 from aerostat_gym.agents.lqg import LQGPolicy, LQGSchedule
 from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule
-from aerostat_gym.agents.modal import ModalPolicy, ModalSchedule, default_zeta
-from aerostat_gym.agents.policies import PassivePolicy
+from aerostat_gym.agents.modal import ModalPolicy, ModalSchedule
+from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy, load_policy
 from aerostat_gym.params import load_params
 
 SPEEDS = (5.0, 10.0, 15.0)
+#: Target pendulum damping ratios of the modal controller's curve per wind speed.
 MODAL_ZETAS = {5.0: (0.16, 0.18, 0.20, 0.22, 0.25), 10.0: (0.35, 0.45, 0.55, 0.60, 0.70),
                15.0: (0.45, 0.60, 0.75, 0.85, 0.95)}
+#: Sensor noise (scaled units) of the LQG's runs and of its filter design.
 LQG_NOISE = 0.01
+#: Reset seed of the LQG's runs (draws the sensor noise).
+LQG_SEED = 3
+#: Learned policies run by default.
+DEFAULT_POLICIES = ("shipped",)
+
+table = frontier_table
+plot = plot_frontier
+
+_NAN = (math.nan, math.nan)
 
 
-def _row(policy, brake, predicted, run, linear_fit=(float("nan"), float("nan"))):
-    return {"policy": policy, "brake": brake, "predicted_zeta": predicted,
+def _row(policy, kind, designed, run, linear_fit=_NAN) -> dict:
+    return {"policy": policy, "kind": kind, "designed_zeta": designed,
             "linear_fit_zeta": linear_fit[0], "linear_drift_zeta": linear_fit[1], **run.row()}
 
 
-def baselines_at(params, U, swing):
-    """Passive, LQR and LQG rows at one wind speed."""
-    rows = []
+def baselines_at(params, U, swing) -> list[dict]:
+    """Passive, tension-feedback, LQR and LQG rows at one wind speed."""
     lqr = LQRSchedule(params, speeds=np.array([U]))
     d = lqr.designs[0]
-    pred = float(d.mode("pendulum").zeta)
+    designed = float(d.mode("pendulum").zeta)
     dx0 = np.append(initial_deviation(U, swing, params), 0.0)
     lin = linear_fit_zeta(d.closed_loop_matrix, d.K, dx0, d.linear.layout.cm_pos.start)
-    braked = float(lqr.designs[0].mode("pendulum", "braked").zeta)
-    rows.append(_row("passive", "dead band", braked, swing_response(PassivePolicy(), U, swing)))
-    pol = LQRPolicy(params, schedule=lqr)
-    for brake, run in (("dead band", swing_response(pol, U, swing, brake_speed=0.02,
-                                                    brake_dwell=0.0)),
-                       ("off", swing_response(pol, U, swing, brake_speed=0.0)),
-                       ("dwell", swing_response(pol, U, swing, params=params))):
-        rows.append(_row("lqr", brake, pred, run, lin))
+    braked = float(d.mode("pendulum", "braked").zeta)
     lqg = LQGPolicy(params, schedule=LQGSchedule(params, speeds=np.array([U]),
                                                  obs_noise=LQG_NOISE))
-    for brake, bs in (("dead band", None), ("off", 0.0)):
-        run = swing_response(lqg, U, swing, brake_speed=bs, obs_noise=LQG_NOISE, seed=3)
-        rows.append(_row("lqg", brake, pred, run, lin))
-    return rows
+    return [
+        _row("passive", "passive", braked, swing_response(PassivePolicy(), U, swing)),
+        _row("tension", "baseline", None,
+             swing_response(TensionFeedbackPolicy.for_params(params), U, swing)),
+        _row("lqr", "baseline", designed,
+             swing_response(LQRPolicy(params, schedule=lqr), U, swing), lin),
+        _row("lqg", "baseline", designed,
+             swing_response(lqg, U, swing, obs_noise=LQG_NOISE, seed=LQG_SEED), lin),
+    ]
 
 
-def modal_curve_at(params, U, swing, zetas):
-    """The modal controller's frontier: one row per target damping ratio in ``zetas``."""
+def modal_curve_at(params, U, swing, zetas) -> list[dict]:
+    """The modal controller's curve: one row per target damping ratio in ``zetas``."""
     rows = []
     dx0 = initial_deviation(U, swing, params)
     for z in zetas:
         sch = ModalSchedule(params, speeds=np.array([U]), zeta=z)
-        pol = ModalPolicy(params, schedule=sch)
         d = sch.designs[0]
         lin = linear_fit_zeta(d.closed_loop_matrix, d.K_subset, dx0[d.index],
                               list(d.index).index(d.lqr.linear.layout.cm_pos.start))
-        for brake, run in (("off", swing_response(pol, U, swing, brake_speed=0.0)),
-                           ("dwell", swing_response(pol, U, swing, params=params))):
-            row = _row("modal", brake, z, run, lin)
-            row["linear_peak_set_point_m_s"] = modal_linear_peak(sch.designs[0], dx0)
-            rows.append(row)
+        run = swing_response(ModalPolicy(params, schedule=sch), U, swing)
+        rows.append(_row("modal", "modal", float(z), run, lin))
     return rows
 
 
-def table(rows) -> str:
-    head = ("| U [m/s] | policy | brake | designed zeta | linear: 1-mode fit | linear: drift "
-            "fit | measured: 1-mode fit | measured: drift fit | peak set-point [m/s] | peak reel "
-            "speed [m/s] | length wander [m] |\n|---|---|---|---|---|---|---|---|---|---|---|")
-    lines = [head]
-    for r in rows:
-        lines.append(f"| {r['wind_speed']:g} | {r['policy']} | {r['brake']} | "
-                     f"{r['predicted_zeta']:.3f} | {r['linear_fit_zeta']:.3f} | "
-                     f"{r['linear_drift_zeta']:.3f} | {r['zeta']:.3f} | {r['zeta_drift']:.3f} | "
-                     f"{r['peak_set_point_m_s']:.3f} | "
-                     f"{r['peak_reel_speed_m_s']:.3f} | {r['length_wander_m']:.2f} |")
-    return "\n".join(lines)
+def learned_at(policies: dict, U, swing) -> list[dict]:
+    """One row per learned policy (label -> policy) at one wind speed."""
+    return [_row(label, "learned", None, swing_response(pol, U, swing))
+            for label, pol in policies.items()]
 
 
-def main(argv=None) -> None:
+def limits_at(params, speeds, swing, rows) -> list[dict]:
+    """The modal line's linear end at the winch's speed limit per wind speed; ``authority``
+    where a measured modal run saturates the winch (the end is then the authority bound)."""
+    vmax = float(params.winch.max_speed)
+    saturated = saturated_speeds(rows, vmax)
+    out = []
+    for U in speeds:
+        z, peak = modal_peak_limit(params, U, swing, peak=vmax)
+        out.append({"wind_speed": float(U), "zeta": float(z), "peak_set_point_m_s": float(peak),
+                    "authority": float(U) in saturated})
+    return out
+
+
+def limits_text(limits) -> str:
+    parts = []
+    for b in limits:
+        s = f"ζ {b['zeta']:.3f} at {b['wind_speed']:g} m/s (peak set-point {b['peak_set_point_m_s']:.3f})"
+        if b["authority"]:
+            s += ", the winch saturates: authority bound"
+        parts.append(s)
+    return "Modal line's linear end at the winch limit: " + "; ".join(parts) + "."
+
+
+def _label(name: str) -> str:
+    return Path(name).stem if name.endswith(".zip") else name
+
+
+def _clean(value):
+    """JSON-safe: NaN -> None, recursively."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_clean(v) for v in value]
+    return value
+
+
+def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--swing", type=float, default=10.0, help="initial along-wind swing [m]")
-    ap.add_argument("--json", default=None, help="write the rows to this JSON file")
-    ap.add_argument("--no-curve", action="store_true", help="modal controller at its default "
-                    "schedule only (one row per speed) instead of the whole curve")
+    ap.add_argument("--policy", action="append", default=None, metavar="NAME_OR_PATH",
+                    help="learned policy to add (repeatable; default: shipped)")
+    ap.add_argument("--json", default=None, help="write rows and limits to this JSON file")
+    ap.add_argument("--plot", default=None, help="write the figure to this PNG file")
     args = ap.parse_args(argv)
+    t0 = time.perf_counter()
     params = load_params()
+    learned = {_label(n): load_policy(n, params) for n in (args.policy or DEFAULT_POLICIES)}
     rows = []
     for U in SPEEDS:
-        zetas = (default_zeta(U),) if args.no_curve else MODAL_ZETAS[U]
-        rows += baselines_at(params, U, args.swing) + modal_curve_at(params, U, args.swing, zetas)
-    print(f"swing {args.swing:g} m, steady wind, 180 s per run\n")
+        rows += (baselines_at(params, U, args.swing) + learned_at(learned, U, args.swing)
+                 + modal_curve_at(params, U, args.swing, MODAL_ZETAS[U]))
+    limits = limits_at(params, SPEEDS, args.swing, rows)
+    print(f"swing {args.swing:g} m, steady wind, shipped winch, 180 s per run\n")
     print(table(rows))
+    print()
+    print(limits_text(limits))
+    out = {"swing_m": args.swing, "lqg_noise": LQG_NOISE, "lqg_seed": LQG_SEED,
+           "max_speed_m_s": float(params.winch.max_speed), "rows": rows, "limits": limits}
     if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
         with open(args.json, "w") as fh:
-            json.dump(rows, fh, indent=1)
+            json.dump(_clean(out), fh, indent=1)
+    if args.plot:
+        Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
+        plot(rows, limits, args.plot, max_speed=float(params.winch.max_speed), swing=args.swing)
+    print(f"\n{time.perf_counter() - t0:.0f} s")
+    return out
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 """The winch-baseline scripts (scripts/winch_frontier.py, scripts/baseline_table.py): table
-formatting and configuration (fast), a one-point frontier run against its recorded figures and
-a two-seed baseline table (slow). Every assertion states its tolerance.
+formatting, configuration and the frontier figure from synthetic rows (fast), a one-point
+frontier run against its recorded figures and a two-seed baseline table (slow). Every
+assertion states its tolerance.
 """
 
 import importlib.util
@@ -11,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from aerostat_gym.agents.frontier import saturated_speeds
 from aerostat_gym.params import load_params
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -24,30 +26,68 @@ def load(name):
 
 
 def test_frontier_table_format_and_targets():
-    """One row formats to the 11-column Markdown table; the modal targets rise with wind speed
-    and lie in (0, 1)."""
+    """One row formats to the 8-column Markdown table (designed zeta blank where there is none);
+    the modal targets rise with wind speed and lie in (0, 1)."""
     fr = load("winch_frontier")
-    row = {"wind_speed": 10.0, "policy": "modal", "brake": "off", "predicted_zeta": 0.6,
-           "linear_fit_zeta": 0.568, "linear_drift_zeta": 0.6, "zeta": 0.545,
-           "zeta_drift": 0.611, "peak_set_point_m_s": 0.716, "peak_reel_speed_m_s": 0.715,
-           "length_wander_m": 8.49}
-    lines = fr.table([row]).splitlines()
-    assert len(lines) == 3 and lines[2].count("|") == 12
-    assert "| 10 | modal | off | 0.600 | 0.568 | 0.600 | 0.545 | 0.611 |" in lines[2]
+    row = {"wind_speed": 10.0, "policy": "modal", "kind": "modal", "designed_zeta": 0.6,
+           "zeta": 0.545, "zeta_drift": 0.611, "peak_set_point_m_s": 0.716,
+           "peak_reel_speed_m_s": 0.715, "length_wander_m": 8.49}
+    learned = {**row, "policy": "shipped", "kind": "learned", "designed_zeta": None}
+    lines = fr.table([row, learned]).splitlines()
+    assert len(lines) == 4 and all(line.count("|") == 9 for line in lines)
+    assert lines[2] == "| 10 | modal | 0.600 | 0.545 | 0.611 | 0.715 | 0.716 | 8.49 |"
+    assert lines[3].startswith("| 10 | shipped |  | 0.545 |")
     for U, zs in fr.MODAL_ZETAS.items():
         assert all(0 < z < 1 for z in zs) and list(zs) == sorted(zs), U
 
 
+def _synthetic_rows():
+    rows = []
+    for U, z0 in ((5.0, 0.15), (10.0, 0.28), (15.0, 0.36)):
+        def r(policy, kind, designed, zeta, peak, U=U):
+            return {"wind_speed": U, "policy": policy, "kind": kind, "designed_zeta": designed,
+                    "zeta": zeta, "zeta_drift": zeta, "peak_reel_speed_m_s": peak,
+                    "peak_set_point_m_s": peak, "length_wander_m": 1.0}
+        rows += [r("passive", "passive", z0, z0, 0.0), r("tension", "baseline", None, z0, 0.1),
+                 r("lqr", "baseline", z0 + 0.05, z0 + 0.05, 0.3),
+                 r("lqg", "baseline", z0 + 0.05, z0 + 0.04, 0.1),
+                 r("shipped", "learned", None, z0 + 0.06, 0.5)]
+        rows += [r("modal", "modal", z0 + dz, z0 + dz, 0.2 + 3 * dz) for dz in (0.02, 0.1, 0.2)]
+    return rows
+
+
+def test_frontier_plot_writes_png(tmp_path):
+    """Synthetic rows draw three panels (one per wind speed) into a PNG of more than 10 kB; the
+    5 m/s authority bound is a horizontal line there only; the modal runs saturating the winch
+    mark that speed (frontier.saturated_speeds)."""
+    fr = load("winch_frontier")
+    rows = _synthetic_rows()
+    limits = [{"wind_speed": U, "zeta": z, "peak_set_point_m_s": 1.0, "authority": U == 5.0}
+              for U, z in ((5.0, 0.22), (10.0, 0.80), (15.0, 0.99))]
+    out = tmp_path / "frontier.png"
+    fig = fr.plot(rows, limits, out, swing=10.0)
+    assert out.exists() and out.stat().st_size > 10_000
+    assert len(fig.axes) == 3
+    assert [a.get_title() for a in fig.axes] == ["U = 5 m/s", "U = 10 m/s", "U = 15 m/s"]
+    texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert {"modal controller", "modal limit (linear)", "passive (braked winch)",
+            "LQR (full state)", "LQG (sensor noise)", "tension feedback", "shipped PPO (learned)",
+            "authority bound (winch saturates)"} <= set(texts)
+    sat = [dict(r, peak_reel_speed_m_s=1.0) if r["wind_speed"] == 5.0 and r["kind"] == "modal"
+           else r for r in rows]
+    assert saturated_speeds(rows) == [] and saturated_speeds(sat) == [5.0]
+
+
 @pytest.mark.slow
 def test_frontier_point_reproduces():
-    """The modal point at 10 m/s, zeta 0.6, 10 m swing: measured 1-mode 0.545 and drift fit
-    0.611 (brake off), peak reel speed 0.715 m/s (each to 0.005)."""
+    """The modal point at 10 m/s, zeta 0.6, 10 m swing, shipped winch: measured 1-mode 0.545 and
+    drift fit 0.611, peak reel speed 0.715 m/s (each to 0.005)."""
     fr = load("winch_frontier")
-    rows = fr.modal_curve_at(load_params(), 10.0, 10.0, (0.6,))
-    off = next(r for r in rows if r["brake"] == "off")
-    assert off["zeta"] == pytest.approx(0.545, abs=0.005)
-    assert off["zeta_drift"] == pytest.approx(0.611, abs=0.005)
-    assert off["peak_reel_speed_m_s"] == pytest.approx(0.715, abs=0.005)
+    (row,) = fr.modal_curve_at(load_params(), 10.0, 10.0, (0.6,))
+    assert row["designed_zeta"] == 0.6
+    assert row["zeta"] == pytest.approx(0.545, abs=0.005)
+    assert row["zeta_drift"] == pytest.approx(0.611, abs=0.005)
+    assert row["peak_reel_speed_m_s"] == pytest.approx(0.715, abs=0.005)
 
 
 @pytest.mark.slow

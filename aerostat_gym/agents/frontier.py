@@ -13,6 +13,12 @@ applied on an exact-zero set-point or after ``winch.brake_dwell`` (10 s) inside 
 band ``winch.brake_speed`` (0.002 m/s), so a controller's small commands reach the drum.
 ``brake_speed`` and ``brake_dwell`` override those two parameters for a run (``brake_speed=0``:
 only an exact zero brakes; ``brake_speed=0.02, brake_dwell=0``: the dead band of 0.2).
+
+The frontier (``scripts/winch_frontier.py`` runs it): :func:`frontier_table` formats one row
+per run as Markdown; :func:`plot_frontier` draws one panel per wind speed (damping of the
+sinusoid-plus-drift fit against peak reel speed; matplotlib is imported there, lazily), with
+:func:`modal_peak_limit`'s linear end of the modal line and, where a modal run saturates the
+winch (:func:`saturated_speeds`), that end as the authority bound.
 """
 
 from __future__ import annotations
@@ -268,3 +274,179 @@ def modal_peak_limit(params, wind_speed: float, swing: float, peak: float = 1.0,
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if peak_at(mid) <= peak else (lo, mid)
     return lo, peak_at(lo)
+
+
+# --- the frontier table and figure -----------------------------------------------------------
+
+#: Marker, colour and legend label of each baseline in the frontier figure (learned policies:
+#: stars; modal: a line).
+BASELINE_MARKERS = {"passive": ("s", "black", "passive (braked winch)"),
+                    "tension": ("^", "tab:green", "tension feedback"),
+                    "lqr": ("D", "tab:red", "LQR (full state)"),
+                    "lqg": ("v", "tab:purple", "LQG (sensor noise)")}
+#: Colours the learned policies take in turn.
+LEARNED_COLOURS = ("gold", "tab:orange", "tab:pink", "tab:cyan", "tab:olive")
+#: Legend names of learned policies known by name (others: their name).
+LEARNED_LABELS = {"shipped": "shipped PPO"}
+#: Relative margin below the speed limit at which a run counts as saturating the winch.
+SATURATION_RTOL = 1e-3
+
+
+def _num(value, fmt: str) -> str:
+    """``value`` in ``fmt``, blank where it is None or NaN."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return ""
+    return format(value, fmt)
+
+
+def frontier_table(rows: list[dict]) -> str:
+    """The frontier rows as a Markdown table (one row per run).
+
+    Each row needs ``wind_speed``, ``policy``, ``designed_zeta`` (None where the policy has no
+    design value), ``zeta``, ``zeta_drift``, ``peak_reel_speed_m_s``, ``peak_set_point_m_s`` and
+    ``length_wander_m``.
+    """
+    lines = ["| U [m/s] | policy | designed ζ | measured ζ: 1-mode fit | measured ζ: drift fit | "
+             "peak reel speed [m/s] | peak set-point [m/s] | length wander [m] |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['wind_speed']:g} | {r['policy']} | {_num(r['designed_zeta'], '.3f')} "
+                     f"| {_num(r['zeta'], '.3f')} | {_num(r['zeta_drift'], '.3f')} | "
+                     f"{r['peak_reel_speed_m_s']:.3f} | {r['peak_set_point_m_s']:.3f} | "
+                     f"{r['length_wander_m']:.2f} |")
+    return "\n".join(lines)
+
+
+def saturates(row: dict, max_speed: float = 1.0) -> bool:
+    """Whether a run's reel speed reached the winch's speed limit (within SATURATION_RTOL)."""
+    return row["peak_reel_speed_m_s"] >= (1.0 - SATURATION_RTOL) * max_speed
+
+
+def saturated_speeds(rows: list[dict], max_speed: float = 1.0) -> list[float]:
+    """Wind speeds at which a measured modal run drives the winch to its speed limit: there the
+    modal line's linear end at the limit is the winch's authority bound, not just the end of
+    one controller's curve."""
+    return sorted({float(r["wind_speed"]) for r in rows
+                   if r.get("kind") == "modal" and saturates(r, max_speed)})
+
+
+def plot_frontier(rows: list[dict], limits: list[dict], out, max_speed: float = 1.0,
+                  swing: float | None = None):
+    """Draw the frontier figure (one panel per wind speed) and save it to ``out`` (PNG).
+
+    Parameters
+    ----------
+    rows : list of dict
+        Runs as in :func:`frontier_table`, with ``kind`` one of 'passive', 'baseline', 'modal'
+        or 'learned'. y is the sinusoid-plus-drift fit (``zeta_drift``), x the peak reel speed.
+    limits : list of dict
+        Per wind speed the modal line's linear end at the speed limit: ``wind_speed``,
+        ``zeta``, ``peak_set_point_m_s`` and ``authority`` (True: the winch saturates there, the
+        end is drawn as a horizontal bound as well).
+    out : str or Path
+        PNG file to write.
+    max_speed : float
+        The winch's speed limit [m/s] (dashed vertical line).
+    swing : float or None
+        Initial swing [m], for the title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure (closed to pyplot; its ``axes`` are the panels).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    speeds = sorted({float(r["wind_speed"]) for r in rows} | {float(b["wind_speed"])
+                                                              for b in limits})
+    learned = list(dict.fromkeys(r["policy"] for r in rows if r["kind"] == "learned"))
+    fig, axes = plt.subplots(1, len(speeds), figsize=(11, 3.9), squeeze=False)
+    axes = axes[0]
+    handles = {}
+
+    def keep(label, h):
+        handles.setdefault(label, h)
+
+    for ax, U in zip(axes, speeds, strict=True):
+        here = [r for r in rows if float(r["wind_speed"]) == U]
+        ys = []
+        bound = next((b for b in limits if float(b["wind_speed"]) == U), None)
+        if bound is not None and bound.get("authority"):
+            h = ax.axhline(bound["zeta"], color="tab:blue", ls=":", lw=1.5)
+            ax.axhspan(bound["zeta"], 1.5, color="tab:blue", alpha=0.08, lw=0)
+            keep("authority bound (winch saturates)", h)
+        modal = sorted((r for r in here if r["kind"] == "modal"),
+                       key=lambda r: r["designed_zeta"])
+        free = [r for r in modal if not saturates(r, max_speed)]
+        sat = [r for r in modal if saturates(r, max_speed)]
+        if free:
+            (h,) = ax.plot([r["peak_reel_speed_m_s"] for r in free],
+                           [r["zeta_drift"] for r in free], "-o", color="tab:blue", ms=5,
+                           zorder=3)
+            keep("modal controller", h)
+        if sat:
+            link = free[-1:] + sat
+            ax.plot([r["peak_reel_speed_m_s"] for r in link], [r["zeta_drift"] for r in link],
+                    ":", color="tab:blue", lw=1, zorder=2)
+            (h,) = ax.plot([r["peak_reel_speed_m_s"] for r in sat],
+                           [r["zeta_drift"] for r in sat], "o", mfc="white", mec="tab:blue",
+                           ms=5, zorder=3)
+            keep("modal, winch saturated (not linear)", h)
+        ys += [r["zeta_drift"] for r in modal]
+        if bound is not None:
+            (h,) = ax.plot([bound["peak_set_point_m_s"]], [bound["zeta"]], "P", ms=10,
+                           color="tab:blue", mec="white", mew=0.8, zorder=4)
+            # below the limit: the design range's end (zeta 0.99) asks for less than the limit
+            short = bound["peak_set_point_m_s"] < 0.99 * max_speed
+            ax.annotate(f"ζ {'≥ ' if short else ''}{bound['zeta']:.2f}",
+                        (bound["peak_set_point_m_s"], bound["zeta"]),
+                        xytext=(-6, 6), textcoords="offset points", ha="right", fontsize=8,
+                        color="tab:blue")
+            ys.append(bound["zeta"])
+            keep("modal limit (linear)", h)
+        for r in here:
+            if r["kind"] in ("passive", "baseline"):
+                m, c, label = BASELINE_MARKERS.get(r["policy"], ("o", "grey", r["policy"]))
+                (h,) = ax.plot([r["peak_reel_speed_m_s"]], [r["zeta_drift"]], m, color=c, ms=7,
+                               mec="white", mew=0.6, zorder=5)
+                keep(label, h)
+            elif r["kind"] == "learned":
+                c = LEARNED_COLOURS[learned.index(r["policy"]) % len(LEARNED_COLOURS)]
+                (h,) = ax.plot([r["peak_reel_speed_m_s"]], [r["zeta_drift"]], "*", color=c,
+                               ms=14, mec="black", mew=0.6, zorder=6)
+                keep(f"{LEARNED_LABELS.get(r['policy'], r['policy'])} (learned)", h)
+            else:
+                continue
+            ys.append(r["zeta_drift"])
+        h = ax.axvline(max_speed, color="grey", ls="--", lw=1)
+        keep(f"winch limit {max_speed:g} m/s", h)
+        ys = [y for y in ys if y is not None and math.isfinite(y)]
+        if ys:
+            lo, hi = min(ys), max(ys)
+            pad = max(hi - lo, 0.05)
+            ax.set_ylim(lo - 0.06 * pad, hi + 0.12 * pad)
+        ax.set_xlim(-0.03, 1.05 * max_speed)
+        ax.set_title(f"U = {U:g} m/s", fontsize=10)
+        ax.set_xlabel("peak reel speed [m/s]")
+        ax.grid(alpha=0.3)
+        ax.tick_params(labelsize=8)
+    axes[0].set_ylabel("pendulum ζ, sinusoid + drift fit\n(within 5 % of the linear "
+                       "eigenvalues)", fontsize=9)
+    order = [label for _, _, label in BASELINE_MARKERS.values()]
+    order += [k for k in handles if k.endswith("(learned)")]
+    order += ["modal controller", "modal, winch saturated (not linear)", "modal limit (linear)",
+              "authority bound (winch saturates)"]
+    labels = [k for k in order if k in handles] + [k for k in handles if k not in order]
+    fig.legend([handles[k] for k in labels], labels, loc="lower center",
+               ncol=min(len(labels), 5), fontsize=8, frameon=False)
+    title = "Pendulum damping against peak reel speed"
+    if swing is not None:
+        title += f" ({swing:g} m along-wind swing, steady wind, shipped winch)"
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout(rect=(0, 0.13 if len(labels) > 5 else 0.07, 1, 1))
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return fig
