@@ -53,7 +53,8 @@ def add_evaluate_parser(sub) -> None:
     p.add_argument("--policy", action="append", required=True,
                    help="passive, tension, lqr, shipped or PATH.zip (repeat to compare)")
     p.add_argument("--suite", choices=list(SUITES), default="tiny",
-                   help="frozen seed suite (scenario: wind speeds, seeds)")
+                   help="frozen seed suite (scenario: wind speeds, seeds); 'report' is the "
+                   "protocol of the README's baseline table (writes protocol.md)")
     p.add_argument("--out", default="runs/evaluate", help="report directory")
     p.add_argument("--json", action="store_true", help="print the metrics as JSON")
     p.add_argument("--no-plots", action="store_true", help="write no PNG plots")
@@ -72,6 +73,9 @@ def _evaluate_command(args) -> int:
         for scenario in results[0]["scenarios"]:
             print(f"{scenario}:\n{comparison_table(results, scenario)}\n")
         print(f"report (Markdown, plots, JSON): {md}")
+        if (md.parent / "protocol.md").is_file():
+            print(f"protocol (per-cell CIs, paired verdicts, aggregate IQM): "
+                  f"{md.parent / 'protocol.md'}")
     return 0
 
 
