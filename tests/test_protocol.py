@@ -90,7 +90,7 @@ def test_report_suite_seeds_are_held_out():
     training = set()
     for path in list((ROOT / "agents" / "hyperparams").glob("*.yml")) + [
             ROOT / "agents" / "ppo_training" / "hyperparams.yml"]:
-        for key, block in yaml.safe_load(path.read_text()).items():
+        for block in yaml.safe_load(path.read_text()).values():
             if isinstance(block, dict) and "n_envs" in block:
                 training |= set(range(0, int(block["n_envs"])))
     assert training == set(range(32))  # ppo: 32 envs; sac, td3: 8

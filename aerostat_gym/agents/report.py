@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from ..resources import SHIPPED_POLICY
-from .evaluate import SCENARIOS, describe_suite, evaluate_policy
 from . import protocol as proto_mod
+from .evaluate import SCENARIOS, describe_suite, evaluate_policy
 from .protocol_stats import bootstrap_mean_ci
 
 COLUMNS = [  # (key, header, format)
@@ -102,10 +102,11 @@ def verdicts(results: list[dict]) -> list[str]:
                 continue
             for e in r["scenarios"]["recover"]["episodes"]:
                 u = e["wind_speed"]
-                if e["seed"] != min(x["seed"] for x in r["scenarios"]["recover"]["episodes"]):
+                seed = e.get("seed", 0)
+                if seed != min(x.get("seed", 0) for x in r["scenarios"]["recover"]["episodes"]):
                     continue  # one line per wind speed (several seeds: see protocol.md)
                 f = next(x for x in by[ref]["scenarios"]["recover"]["episodes"]
-                         if x["wind_speed"] == u and x["seed"] == e["seed"])
+                         if x["wind_speed"] == u and x.get("seed", 0) == seed)
                 d = e["pendulum_zeta"] - f["pendulum_zeta"]
                 word = ("better" if d > ZETA_TOLERANCE else "worse" if d < -ZETA_TOLERANCE
                         else f"within the {ZETA_TOLERANCE} tolerance")
