@@ -176,3 +176,26 @@ def test_noisy_episode_records_clean_tension_and_differs_by_seed():
     m0, m1 = episode_metrics(tf, 0), episode_metrics(tf, 1)
     assert abs(m0["winch_energy_J"] - m1["winch_energy_J"]) > 10.0
     assert m0["terminated"] == 0.0 and "length_wander_m" in m0
+
+
+def test_evaluate_writes_the_protocol_tables(tmp_path, capsys):
+    """``aerostat-gym evaluate --suite report-tiny`` with two policies writes protocol.md (one
+    table per cell, the aggregate) and report.json with the paired differences; the terminal
+    shows no image links."""
+    import json
+
+    from aerostat_gym.cli import main
+
+    assert main(["evaluate", "--policy", "passive", "--policy", "tension", "--suite",
+                 "report-tiny", "--out", str(tmp_path), "--no-plots"]) == 0
+    printed = capsys.readouterr().out
+    assert "![" not in printed and "protocol.md" in printed
+    md = (tmp_path / "protocol.md").read_text()
+    assert "### gusty_severe, 16 m/s, 2 seeds" in md
+    assert "### recover_cross_small, 10 m/s, 2 seeds" in md
+    assert "| tension |" in md and "P(better than passive)" in md
+    data = json.loads((tmp_path / "report.json").read_text())
+    paired = data[1]["scenarios"]["gusty_severe"]["paired"][0]
+    assert paired["wind_speed"] == 16.0
+    assert paired["passive"]["rms_x_m"]["verdict"] in ("better", "worse", "indistinguishable")
+    assert data[0]["obs_noise"] == 0.01

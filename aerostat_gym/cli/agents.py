@@ -8,7 +8,13 @@ import time
 
 from ..agents.evaluate import SUITES
 from ..agents.policies import load_policy
-from ..agents.report import comparison_table, jsonable, run_evaluations, write_report
+from ..agents.report import (
+    comparison_table,
+    jsonable,
+    protocol_for,
+    run_evaluations,
+    write_report,
+)
 from ..agents.train import ALGOS, train
 from ..analysis.modes import analyse
 from ..analysis.trim import find_equilibrium
@@ -68,7 +74,7 @@ def _evaluate_command(args) -> int:
     md = write_report(results, args.out, f"Evaluation on suite `{args.suite}`",
                       "aerostat-gym " + " ".join(sys.argv[1:]), plots=not args.no_plots)
     if args.json:
-        print(json.dumps(jsonable(results), indent=1))
+        print(json.dumps(jsonable(results, protocol_for(results)), indent=1))
     else:
         for scenario in results[0]["scenarios"]:
             print(f"{scenario}:\n{comparison_table(results, scenario)}\n")
