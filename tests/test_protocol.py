@@ -199,3 +199,17 @@ def test_evaluate_writes_the_protocol_tables(tmp_path, capsys):
     assert paired["wind_speed"] == 16.0
     assert paired["passive"]["rms_x_m"]["verdict"] in ("better", "worse", "indistinguishable")
     assert data[0]["obs_noise"] == 0.01
+
+
+def test_rounding_level_differences_are_indistinguishable():
+    """A point interval of 8e-18 m (two deterministic episodes differing by rounding) is no
+    difference; one of 1 mm on both seeds is."""
+    from aerostat_gym.agents.protocol import paired_verdict
+    from aerostat_gym.agents.protocol_stats import Interval
+
+    assert paired_verdict(Interval(8e-18, 8e-18, 8e-18, 0.95, 20), "rms_y_m") \
+        == "indistinguishable"
+    assert paired_verdict(Interval(1e-3, 1e-3, 1e-3, 0.95, 20), "rms_y_m") == "worse"
+    assert paired_verdict(Interval(-1e-3, -2e-3, -5e-4, 0.95, 20), "rms_y_m") == "better"
+    assert paired_verdict(Interval(0.01, -0.01, 0.03, 0.95, 20), "pendulum_zeta") \
+        == "indistinguishable"

@@ -10,8 +10,13 @@ Per cell (scenario, wind speed), over the seeds:
   where the paired interval excludes zero, in the metric's direction
   (:data:`aerostat_gym.agents.protocol_table.LOWER_IS_BETTER`: RMS figures, tension, length
   wander, energy and terminations lower is better; damping ratios and the return higher),
-  "indistinguishable" otherwise. Pairs where either value is not finite (a failed fit, a
-  terminated episode's RMS) are dropped; fewer than two pairs give "n/a".
+  "indistinguishable" otherwise. The interval must also clear the metric's numerical
+  resolution (:data:`RESOLUTION`, far below the printed digits): a policy that reads no noisy
+  channel (passive, LQR, modal) runs the same episode at every seed of a calm recover cell, so
+  its paired interval is a point, and a rounding-level difference (8e-18 m of RMS cross-wind
+  displacement after an along-wind swing) must not count. Pairs where either value is not
+  finite (a failed fit, a terminated episode's RMS) are dropped; fewer than two pairs give
+  "n/a".
 
 Aggregate, per policy, over every cell: the interquartile mean of a per-episode score with a
 stratified-bootstrap interval, and the probability of improvement over every other policy (with
@@ -54,6 +59,12 @@ FREE_METRICS = ("pitch_zeta", "rms_x_m", "rms_y_m", "rms_pitch_rad", "rms_pitch_
 FORCED_METRICS = ("rms_x_m", "rms_y_m", "rms_pitch_rad", "rms_pitch_rate_rad_s",
                   "peak_tension_N", "length_wander_m", "winch_energy_J", "terminated", "return")
 PENDULUM_METRIC = {"x": "pendulum_zeta", "y": "lateral_pendulum_zeta"}
+#: Paired differences within +-resolution are no difference (units of the metric); the
+#: default for a metric not listed is 1e-9.
+RESOLUTION = {"pendulum_zeta": 1e-4, "lateral_pendulum_zeta": 1e-4, "pitch_zeta": 1e-4,
+              "rms_x_m": 1e-4, "rms_y_m": 1e-4, "rms_pitch_rad": 1e-6,
+              "rms_pitch_rate_rad_s": 1e-6, "peak_tension_N": 0.1, "length_wander_m": 1e-4,
+              "winch_energy_J": 0.1, "terminated": 1e-9, "return": 1e-6}
 #: Columns of the Markdown cell tables: (metric, header, scale, digits).
 SHOW = {"pendulum_zeta": ("pend. zeta (long.)", 1.0, 3),
         "lateral_pendulum_zeta": ("pend. zeta (lat.)", 1.0, 3),
@@ -106,6 +117,15 @@ def paired_interval(a, b) -> Interval | None:
         return Interval(float(d[0]), float(d[0]), float(d[0]), 0.95, int(d.size))
     method = "studentized" if d.size >= STUDENTIZED_MIN_SEEDS else "percentile"
     return paired_difference_ci(a[keep], b[keep], method=method)
+
+
+def paired_verdict(diff: Interval, metric: str) -> str:
+    """"better", "worse" or "indistinguishable": the paired interval of policy - baseline must
+    exclude zero and clear the metric's :data:`RESOLUTION`, in the metric's direction."""
+    tol = RESOLUTION.get(metric, 1e-9)
+    if diff.low <= tol and diff.high >= -tol:
+        return "indistinguishable"
+    return verdict(diff, higher_is_better=metric not in LOWER_IS_BETTER)
 
 
 def _values(result: dict, scenario: str, speed: float, metric: str) -> tuple[list, np.ndarray]:
@@ -178,7 +198,7 @@ def protocol(results: list[dict], baselines=BASELINES, seed: int = 0) -> dict:
                     iv = paired_interval(vals[lab][m], vals[ref][m])
                     per[m] = ({"diff": None, "ci": None, "verdict": "n/a"} if iv is None else
                               {"diff": iv.estimate, "ci": [iv.low, iv.high],
-                               "verdict": verdict(iv, higher_is_better=m not in LOWER_IS_BETTER)})
+                               "verdict": paired_verdict(iv, m)})
                 cell["paired"][lab][ref] = per
         cells.append(cell)
     out = {"cells": cells, "baselines": refs}
