@@ -213,3 +213,17 @@ def test_rounding_level_differences_are_indistinguishable():
     assert paired_verdict(Interval(-1e-3, -2e-3, -5e-4, 0.95, 20), "rms_y_m") == "better"
     assert paired_verdict(Interval(0.01, -0.01, 0.03, 0.95, 20), "pendulum_zeta") \
         == "indistinguishable"
+
+
+def test_aggregate_pools_the_cells_with_the_most_seeds():
+    """The tiny suite's recover cells have one seed and its gusty cell two: the aggregate pools
+    the gusty cell only (a score matrix needs equal runs per column)."""
+    def res(label, ret):
+        return {"label": label, "suite": "tiny", "score": 0.0, "scenarios": {
+            "recover": {"episodes": [_episode(0, **{"return": ret})]},
+            "gusty": {"episodes": [_episode(s, **{"return": ret * s}) for s in (100, 101)]}}}
+
+    proto = protocol([res("passive", -2.0), res("mine", -1.0)])
+    assert proto["aggregate_cells"] == ["gusty 10 m/s"]
+    assert proto["aggregate"]["mine"]["iqm"] == pytest.approx(100.5 / -201.0)
+    assert "1 of 2 cells with the most seeds" in protocol_markdown(proto)

@@ -213,12 +213,21 @@ def scores(results: list[dict]) -> tuple[str, dict]:
     ref = "passive" if "passive" in labels else labels[0]
     by = {r["label"]: r for r in results}
     cols = {lab: [] for lab in labels}
-    for s, u in _cells(results):
+    for s, u in aggregate_cells(results):
         norm = abs(float(np.mean(_values(by[ref], s, u, "return")[1])))
         norm = norm if norm > 0.0 else 1.0
         for lab in labels:
             cols[lab].append(_values(by[lab], s, u, "return")[1] / norm)
     return ref, {lab: np.column_stack(c) for lab, c in cols.items()}
+
+
+def aggregate_cells(results: list[dict]) -> list[tuple[str, float]]:
+    """The cells the aggregate pools: those with the most seeds (a score matrix needs the same
+    runs in every column; in the report suites that is every cell)."""
+    cells = _cells(results)
+    n = {c: len(_values(results[0], *c, "return")[0]) for c in cells}
+    top = max(n.values())
+    return [c for c in cells if n[c] == top]
 
 
 def aggregate(results: list[dict], seed: int = 0) -> dict:
@@ -238,8 +247,9 @@ def aggregate(results: list[dict], seed: int = 0) -> dict:
             p = probability_of_improvement_ci(s, t, seed=seed)
             row["p_improvement"][other] = {"p": p.estimate, "ci": [p.low, p.high]}
         agg[lab] = row
+    cells = aggregate_cells(results)
     return {"score": f"episode return / |mean return of {ref} in the same cell|",
-            "aggregate": agg}
+            "aggregate_cells": [f"{s} {u:g} m/s" for s, u in cells], "aggregate": agg}
 
 
 def _num(v: float, scale: float, digits: int) -> str:
@@ -309,7 +319,10 @@ def protocol_markdown(proto: dict, reference: str = "passive") -> str:
         desc = f" ({sc.description})" if sc is not None else ""
         parts += [f"### {cell['scenario']}, {cell['wind_speed']:g} m/s, "
                   f"{cell['n_seeds']} seeds{desc}", "", cell_markdown(cell, ref), ""]
-    parts += ["### Aggregate over all cells", "",
+    n_all, cells = len(proto["cells"]), proto["aggregate_cells"]
+    over = ("all cells" if len(cells) == n_all else
+            f"the {len(cells)} of {n_all} cells with the most seeds ({', '.join(cells)})")
+    parts += [f"### Aggregate over {over}", "",
               f"Score: {proto['score']} (higher is better); IQM with a stratified-bootstrap "
               "95 % interval, probability of improvement in the style of rliable.", "",
               aggregate_markdown(proto), ""]
