@@ -1,19 +1,39 @@
 """``aerostat-gym evaluate``: one evaluator for the baselines and SB3 policies on frozen suites.
 
-Scenarios:
+Scenarios (:data:`SCENARIOS`; the along-wind swing, cross-wind displacement and pitch kick are
+fixed, not drawn: a rigid rotation of aerostat and tether about the winch, then a pitch about
+the confluence point, :func:`aerostat_gym.envs.episodes._perturb`):
 
 - ``recover``: steady wind (no turbulence), the aerostat and tether swung 10 m along the wind
-  and the aerostat pitched 0.05 rad (fixed, not drawn), 180 s: damping ratios and periods of
-  the longitudinal pendulum and the pitch oscillation identified by fitting damped sinusoids.
-- ``gusty``: moderate turbulence (von Karman, sigma_u = 1.6 m/s), no initial perturbation,
-  120 s: RMS displacement and pitch, tension, winch energy.
+  and the aerostat pitched 0.05 rad, 180 s: damping ratios and periods of the longitudinal
+  pendulum and the pitch oscillation identified by fitting damped sinusoids.
+- ``recover_small``: as ``recover`` at a tenth of the amplitude (1 m, 0.005 rad): the linear
+  regime, where the brake's dead band and the winch's speed limit matter most.
+- ``recover_cross`` / ``recover_cross_small``: 10 m / 1 m across the wind (+y) and 0.05 /
+  0.005 rad of pitch: the lateral pendulum, fitted on the cross-wind displacement.
+- ``recover_combined`` / ``recover_combined_small``: 10 m / 1 m at 45 degrees (7.07 m along and
+  7.07 m across; 0.707 m and 0.707 m) and 0.05 / 0.005 rad: both pendulums, each fitted on its
+  own displacement (along-wind: longitudinal; cross-wind: lateral).
+- ``gusty_light``, ``gusty`` (moderate) and ``gusty_severe``: the turbulence class's von Karman
+  field (sigma_u / U(h) = 5 %, 10 %, 15 % at the aerostat), no initial perturbation, 120 s: RMS
+  displacement, pitch and pitch rate, tension, length wander, winch energy.
 
-Suites fix the wind speeds and seeds (``SUITES``), so a number in a report can be reproduced
-exactly. The suite score is the mean episode return under the environment's default reward.
+Suites (:data:`SUITES`) fix the wind speeds and seeds, so a number in a report can be
+reproduced exactly. ``damping``, ``tiny``, ``small`` and ``full`` run without sensor noise, so
+in the recover scenarios every seed is the same episode. ``report`` (the frozen protocol of
+the README's baseline table) runs every scenario above at seeds 5000-5019 with the sensor noise
+:data:`SENSOR_NOISE` on (:data:`SUITE_OBS_NOISE`), so the seeds of a cell differ and their
+intervals mean something; ``report-tiny`` is a two-seed cut of it for tests. The report seeds
+are disjoint from the training seeds (the SB3 VecEnv seeds environment i of ``aerostat-gym
+train --seed S`` with S + i: 0-31 for the shipped policy), from the other suites (0, 100-109)
+and from the task-returns table (1000-1019).
+
+The suite score is the mean episode return under the environment's default reward.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,22 +46,110 @@ from .metrics import response_metrics
 from .policies import load_policy
 from .sb3io import PolicyError
 
-RECOVER = {"turbulence": "none",
-           "perturbation": {"swing": 10.0, "pitch": 0.05, "fixed": True}}
-GUSTY = {"turbulence": "moderate", "perturbation": "none"}
-SCENARIOS = {"recover": (RECOVER, 180.0), "gusty": (GUSTY, 120.0)}
+#: Sensor noise of the report suites (std in the observation's scaled units, on every standard
+#: channel): the level the LQG baseline is designed for and evaluated at in the README and
+#: scripts/baseline_table.py. It reaches the policies that read the standard channels
+#: (passive ignores them; tension feedback, LQG and learned policies do); the privileged LQR
+#: and modal controllers read the appended full state, which carries no noise.
+SENSOR_NOISE = 0.01
+
+
+def _recover(along: float, lateral: float, pitch: float) -> dict:
+    return {"turbulence": "none",
+            "perturbation": {"swing": along, "lateral": lateral, "pitch": pitch, "fixed": True}}
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One evaluation scenario: environment keyword arguments, duration [s], a one-line
+    description and, for a free response, the displacements its pendulum fits use ("x":
+    along-wind, longitudinal pendulum; "y": cross-wind, lateral pendulum; empty for a forced
+    response, which gets no damping fits)."""
+
+    env_kwargs: dict
+    duration: float
+    description: str
+    pendulums: tuple = ()
+
+    @property
+    def free(self) -> bool:
+        return bool(self.pendulums)
+
+
+_D = 10.0 / math.sqrt(2.0)  # 7.07 m: a 10 m swing at 45 degrees
+SCENARIOS = {
+    "recover": Scenario(_recover(10.0, 0.0, 0.05), 180.0,
+                        "calm, 10 m along-wind swing + 0.05 rad pitch", ("x",)),
+    "recover_small": Scenario(_recover(1.0, 0.0, 0.005), 180.0,
+                              "calm, 1 m along-wind swing + 0.005 rad pitch", ("x",)),
+    "recover_cross": Scenario(_recover(0.0, 10.0, 0.05), 180.0,
+                              "calm, 10 m cross-wind swing + 0.05 rad pitch", ("y",)),
+    "recover_cross_small": Scenario(_recover(0.0, 1.0, 0.005), 180.0,
+                                    "calm, 1 m cross-wind swing + 0.005 rad pitch", ("y",)),
+    "recover_combined": Scenario(_recover(_D, _D, 0.05), 180.0,
+                                 "calm, 7.07 m along + 7.07 m across + 0.05 rad pitch",
+                                 ("x", "y")),
+    "recover_combined_small": Scenario(_recover(_D / 10, _D / 10, 0.005), 180.0,
+                                       "calm, 0.707 m along + 0.707 m across + 0.005 rad pitch",
+                                       ("x", "y")),
+    "gusty_light": Scenario({"turbulence": "light", "perturbation": "none"}, 120.0,
+                            "light turbulence (sigma_u/U = 5 %), no perturbation"),
+    "gusty": Scenario({"turbulence": "moderate", "perturbation": "none"}, 120.0,
+                      "moderate turbulence (sigma_u/U = 10 %), no perturbation"),
+    "gusty_severe": Scenario({"turbulence": "severe", "perturbation": "none"}, 120.0,
+                             "severe turbulence (sigma_u/U = 15 %), no perturbation"),
+}
+RECOVER = SCENARIOS["recover"].env_kwargs
+GUSTY = SCENARIOS["gusty"].env_kwargs
+
+#: Seeds of the report suite: disjoint from training (0-31 for the shipped policy), the other
+#: suites (0, 100-109) and the task-returns table (1000-1019).
+REPORT_SEEDS = list(range(5000, 5020))
+REPORT_RECOVER_SPEEDS = [5.0, 10.0, 15.0]
+#: 16 m/s lies outside the training range DEFAULT_WIND_RANGE = (3, 15).
+REPORT_GUSTY_SPEEDS = [4.0, 8.0, 12.0, 16.0]
+RECOVER_SCENARIOS = [k for k, s in SCENARIOS.items() if s.free]
+GUSTY_SCENARIOS = [k for k, s in SCENARIOS.items() if not s.free]
+
 SUITES = {
     "damping": {"recover": ([5.0, 10.0, 15.0], [0])},  # model selection during training
     "tiny": {"recover": ([5.0, 10.0, 15.0], [0]), "gusty": ([10.0], [100, 101])},
     "small": {"recover": ([5.0, 10.0, 15.0], [0]), "gusty": ([5.0, 10.0, 15.0], [100, 101, 102])},
     "full": {"recover": ([3.0, 5.0, 7.5, 10.0, 12.5, 15.0], [0]),
              "gusty": ([5.0, 10.0, 15.0], list(range(100, 110)))},
+    "report": {**{k: (REPORT_RECOVER_SPEEDS, REPORT_SEEDS) for k in RECOVER_SCENARIOS},
+               **{k: (REPORT_GUSTY_SPEEDS, REPORT_SEEDS) for k in GUSTY_SCENARIOS}},
+    "report-tiny": {"recover_cross_small": ([10.0], REPORT_SEEDS[:2]),
+                    "gusty_severe": ([16.0], REPORT_SEEDS[:2])},
 }
+#: Sensor noise per suite (0 where absent).
+SUITE_OBS_NOISE = {"report": SENSOR_NOISE, "report-tiny": SENSOR_NOISE}
+
+
+def suite_seeds(name: str) -> set:
+    """Every seed a suite uses."""
+    return {s for _, seeds in check_suite(name).values() for s in seeds}
+
+
+def describe_suite(name: str) -> str:
+    """One line per scenario of a suite: wind speeds, seeds (as ranges) and description."""
+    lines = []
+    for scenario, (speeds, seeds) in check_suite(name).items():
+        s = sorted(seeds)
+        span = (f"{s[0]}-{s[-1]}" if len(s) > 2 and s == list(range(s[0], s[-1] + 1))
+                else ", ".join(map(str, s)))
+        lines.append(f"- `{scenario}` ({SCENARIOS[scenario].description}, "
+                     f"{SCENARIOS[scenario].duration:g} s): U = "
+                     f"{', '.join(f'{u:g}' for u in speeds)} m/s; seeds {span}")
+    noise = SUITE_OBS_NOISE.get(name, 0.0)
+    lines.append(f"- sensor noise obs_noise = {noise:g} (scaled units)")
+    return "\n".join(lines)
 
 
 @dataclass
 class Episodes:
-    """Time histories of one scenario for one policy (arrays: episode x sample)."""
+    """Time histories of one scenario for one policy (arrays: episode x sample; NaN after a
+    termination)."""
 
     scenario: str
     speeds: np.ndarray
@@ -49,10 +157,13 @@ class Episodes:
     time: np.ndarray
     x: np.ndarray  # along-wind CM displacement from trim [m]
     pitch: np.ndarray  # pitch minus trim [rad]
-    tension: np.ndarray  # winch tension [N]
+    tension: np.ndarray  # winch tension [N] (noise-free, whatever the sensor noise)
     reel_speed: np.ndarray  # [m/s]
     returns: np.ndarray
     ended: list  # termination reason or None per episode
+    y: np.ndarray | None = None  # cross-wind CM displacement from trim [m]
+    pitch_rate: np.ndarray | None = None  # body rate q [rad/s]
+    length: np.ndarray | None = None  # paid-out tether length minus trim [m]
 
 
 def check_suite(name: str) -> dict:
@@ -63,31 +174,49 @@ def check_suite(name: str) -> dict:
 
 def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2,
                  env_kwargs: dict | None = None) -> Episodes:
-    """Run ``policy`` on every (speed, seed) pair of a scenario in one batched environment."""
-    kwargs, duration = SCENARIOS[scenario]
+    """Run ``policy`` on every (speed, seed) pair of a scenario in one batched environment.
+
+    The environment's wind-speed range is the training range DEFAULT_WIND_RANGE widened to
+    the requested speeds (so the suites inside it run on exactly the training environment's
+    trims and turbulence bank). The tension is recorded from the noise-free state: with
+    ``obs_noise`` the policy sees a noisy load cell, the metrics do not.
+    """
+    sc = SCENARIOS[scenario]
     pairs = [(u, s) for u in speeds for s in seeds]
-    steps = int(round(duration / control_step))
+    steps = int(round(sc.duration / control_step))
+    lo, hi = DEFAULT_WIND_RANGE
+    kwargs = {"wind_speed": (min(lo, min(speeds)), max(hi, max(speeds))),
+              **(env_kwargs or {}), **sc.env_kwargs}
     env = TetheredAerostatVectorEnv(num_envs=len(pairs), max_episode_steps=steps,
-                                    observation="full", control_step=control_step,
-                                    **{**(env_kwargs or {}), **kwargs})
+                                    observation="full", control_step=control_step, **kwargs)
+    noisy = env.task.obs_noise > 0.0
     obs, _ = env.reset(seed=[s for _, s in pairs],
                        options={"wind_speed": [u for u, _ in pairs]})
     b, lay = env.batch, env.batch.layout
-    ix, ith, iv = lay.cm_pos.start, lay.euler.start + 1, lay.winch_speed
-    rec = {k: np.zeros((len(pairs), steps + 1)) for k in ("x", "pitch", "tension", "reel")}
+    ix, iy, ith = lay.cm_pos.start, lay.cm_pos.start + 1, lay.euler.start + 1
+    iq, iv, il = lay.rates.start + 1, lay.winch_speed, lay.winch_length
+    names = ("x", "y", "pitch", "q", "length", "tension", "reel")
+    rec = {k: np.zeros((len(pairs), steps + 1)) for k in names}
 
     def record(k, obs, alive):
-        rec["x"][:, k] = np.where(alive, b.state[:, ix] - b.trim_state[:, ix], np.nan)
-        rec["pitch"][:, k] = np.where(alive, b.state[:, ith] - b.trim_state[:, ith], np.nan)
+        d = b.state - b.trim_state
+        for name, col in (("x", ix), ("y", iy), ("pitch", ith), ("length", il)):
+            rec[name][:, k] = np.where(alive, d[:, col], np.nan)
+        rec["q"][:, k] = np.where(alive, b.state[:, iq], np.nan)
+        rec["reel"][:, k] = np.where(alive, b.state[:, iv], np.nan)
+        if noisy:  # the load cell without its noise: the batch's observation recomputed
+            for i in np.flatnonzero(alive):  # (the policy already holds its noisy copy)
+                b.observe(i)
+            obs = b.obs
         rec["tension"][:, k] = np.where(alive, obs[:, OBS_TENSION] * CHANNELS[OBS_TENSION].scale,
                                         np.nan)
-        rec["reel"][:, k] = np.where(alive, b.state[:, iv], np.nan)
 
     returns, ended = rollout(policy, env, obs, steps, record)
     env.close()
     t = np.arange(steps + 1) * control_step
     return Episodes(scenario, np.array([u for u, _ in pairs]), np.array([s for _, s in pairs]),
-                    t, rec["x"], rec["pitch"], rec["tension"], rec["reel"], returns, ended)
+                    t, rec["x"], rec["pitch"], rec["tension"], rec["reel"], returns, ended,
+                    y=rec["y"], pitch_rate=rec["q"], length=rec["length"])
 
 
 def rollout(policy, env, obs: np.ndarray, steps: int, record=None) -> tuple[np.ndarray, list]:
@@ -127,9 +256,21 @@ def policy_obs(policy, obs: np.ndarray) -> np.ndarray:
 
 
 def episode_metrics(ep: Episodes, i: int) -> dict:
-    m = response_metrics(ep.time, ep.x[i], ep.pitch[i], ep.tension[i], ep.reel_speed[i])
+    """Per-episode metrics (:func:`aerostat_gym.agents.metrics.response_metrics`) with the
+    wind speed, seed, return, termination reason (``ended``) and ``terminated`` (1.0 or 0.0).
+    The lateral pendulum is fitted only in scenarios that swing across the wind."""
+    sc = SCENARIOS.get(ep.scenario)
+    lateral = sc is not None and "y" in sc.pendulums
+
+    def row(a):
+        return None if a is None else a[i]
+
+    m = response_metrics(ep.time, ep.x[i], ep.pitch[i], ep.tension[i], ep.reel_speed[i],
+                         y_disp=row(ep.y), pitch_rate=row(ep.pitch_rate),
+                         length_dev=row(ep.length), fit_lateral=lateral)
     m.update({"wind_speed": float(ep.speeds[i]), "seed": int(ep.seeds[i]),
-              "return": float(ep.returns[i]), "ended": ep.ended[i]})
+              "return": float(ep.returns[i]), "ended": ep.ended[i],
+              "terminated": float(ep.ended[i] is not None)})
     return m
 
 
@@ -139,18 +280,21 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
 
     ``params`` (a Params, a TOML path, a shipped configuration's name or None for the baseline)
     is the configuration of both the baselines' design and the environment the suite runs on;
-    the resolved parameters are recorded in the result (``params_toml``).
+    the resolved parameters are recorded in the result (``params_toml``). The suite's sensor
+    noise (:data:`SUITE_OBS_NOISE`) is on in its environments and the LQG filter is designed
+    for it.
     """
     spec = check_suite(suite)
+    noise = SUITE_OBS_NOISE.get(suite, 0.0)
     params = params if params is not None and not isinstance(params, str) else load_params(params)
     policy = load_policy(policy_name, params=params, dt=control_step,
-                         wind_range=DEFAULT_WIND_RANGE)
-    out = {"policy": policy_name, "suite": suite, "scenarios": {},
+                         wind_range=DEFAULT_WIND_RANGE, obs_noise=noise)
+    out = {"policy": policy_name, "suite": suite, "scenarios": {}, "obs_noise": noise,
            "tether_length_m": params.tether.length, "params_toml": dumps_toml(params)}
     returns = []
     for scenario, (speeds, seeds) in spec.items():
         ep = run_scenario(policy, scenario, speeds, seeds, control_step,
-                          env_kwargs={"params": params})
+                          env_kwargs={"params": params, "obs_noise": noise})
         rows = [episode_metrics(ep, i) for i in range(len(ep.speeds))]
         if hasattr(policy, "predicted_modes"):
             for r in rows:
@@ -163,9 +307,11 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
 
 def suite_score(policy, suite: str = "tiny", control_step: float = 0.2, params=None) -> float:
     """Mean episode return of a policy object on a suite (the training curve's measure), in
-    the environment of ``params`` (default: the baseline)."""
+    the environment of ``params`` (default: the baseline) with the suite's sensor noise."""
     returns = []
-    kwargs = None if params is None else {"params": params}
+    kwargs = {"obs_noise": SUITE_OBS_NOISE.get(suite, 0.0)}
+    if params is not None:
+        kwargs["params"] = params
     for scenario, (speeds, seeds) in check_suite(suite).items():
         returns.extend(run_scenario(policy, scenario, speeds, seeds, control_step,
                                     env_kwargs=kwargs).returns)

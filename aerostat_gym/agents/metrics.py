@@ -286,7 +286,9 @@ def response_metrics(time, x_disp, pitch, tension, reel_speed, *,
                      pendulum_period_guess: float | None = None,
                      pitch_period_guess: float | None = None,
                      pitch_highpass_hz: float = 0.1, settle_fraction: float = 0.05,
-                     fit_start: float | None = None) -> dict:
+                     fit_start: float | None = None, y_disp=None, pitch_rate=None,
+                     length_dev=None, fit_lateral: bool = False,
+                     lateral_period_guess: float | None = None) -> dict:
     """Metrics of one response from its time histories (all arrays over the same samples).
 
     Parameters
@@ -299,12 +301,23 @@ def response_metrics(time, x_disp, pitch, tension, reel_speed, *,
     fit_start : fit the modes only to samples with time >= fit_start [s] (e.g. after a forcing
         pulse ends: the fits model a free response). Default: all samples. The other metrics
         always use the whole record.
+    y_disp : cross-wind CM displacement from trim [m] (optional: ``rms_y_m``; with
+        ``fit_lateral`` also the lateral pendulum fitted on it).
+    pitch_rate : body pitch rate q [rad/s] (optional: ``rms_pitch_rate_rad_s``).
+    length_dev : paid-out tether length minus trim [m] (optional: ``length_wander_m`` =
+        max |L - L_trim| and ``rms_length_m``).
+    fit_lateral : fit a damped sinusoid to ``y_disp`` (``lateral_pendulum_*``).
+    lateral_period_guess : start period of that fit [s].
 
     Returns
     -------
     dict of floats: pendulum_zeta, pendulum_period_s, pendulum_fit_r2, pitch_zeta,
     pitch_period_s, pitch_fit_r2, settling_time_s, rms_x_m, rms_pitch_rad, peak_tension_N,
-    rms_tension_N, tension_std_N, winch_energy_J, peak_winch_power_W, peak_reel_speed_m_s.
+    rms_tension_N, tension_std_N, winch_energy_J, peak_winch_power_W, peak_reel_speed_m_s;
+    with the optional histories also rms_y_m, lateral_pendulum_zeta, lateral_pendulum_period_s,
+    lateral_pendulum_fit_r2 (NaN unless ``fit_lateral``), rms_pitch_rate_rad_s,
+    length_wander_m, rms_length_m. A history with NaNs (an episode that terminated) gives NaN
+    for its RMS and peak figures.
 
     Notes
     -----
@@ -335,7 +348,7 @@ def response_metrics(time, x_disp, pitch, tension, reel_speed, *,
     pit = _pitch_fit(t[w], th[w], pend, pitch_period_guess, pitch_highpass_hz)
     power = np.abs(T * v)
     energy = float(np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(t))) if t.size > 1 else 0.0
-    return {
+    out = {
         "pendulum_zeta": pend.zeta,
         "pendulum_period_s": pend.period,
         "pendulum_fit_r2": pend.r2,
@@ -352,4 +365,18 @@ def response_metrics(time, x_disp, pitch, tension, reel_speed, *,
         "peak_winch_power_W": float(np.max(power)) if power.size else NAN,
         "peak_reel_speed_m_s": float(np.max(np.abs(v))) if v.size else NAN,
     }
+    if y_disp is not None:
+        yd = np.asarray(y_disp, dtype=float).ravel()
+        out["rms_y_m"] = _rms(yd)
+        lat = (fit_damped_sinusoid(t[w], yd[w], lateral_period_guess) if fit_lateral
+               else _failed("not fitted"))
+        out.update({"lateral_pendulum_zeta": lat.zeta, "lateral_pendulum_period_s": lat.period,
+                    "lateral_pendulum_fit_r2": lat.r2})
+    if pitch_rate is not None:
+        out["rms_pitch_rate_rad_s"] = _rms(pitch_rate)
+    if length_dev is not None:
+        dl = np.asarray(length_dev, dtype=float).ravel()
+        out["length_wander_m"] = float(np.max(np.abs(dl))) if dl.size else NAN
+        out["rms_length_m"] = _rms(dl)
+    return out
 

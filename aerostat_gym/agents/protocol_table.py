@@ -22,7 +22,8 @@ from .protocol_stats import (
 #: Metrics where smaller is better (the rest, e.g. damping ratios and returns, larger).
 LOWER_IS_BETTER = ("rms_x_m", "rms_pitch_rad", "peak_tension_N", "rms_tension_N",
                    "tension_std_N", "winch_energy_J", "peak_winch_power_W",
-                   "peak_reel_speed_m_s", "settling_time_s")
+                   "peak_reel_speed_m_s", "settling_time_s", "rms_y_m",
+                   "rms_pitch_rate_rad_s", "length_wander_m", "rms_length_m", "terminated")
 
 
 def cell_table(values: dict, metrics, baseline: str, seed: int = 0) -> list[dict]:

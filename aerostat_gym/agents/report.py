@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from ..resources import SHIPPED_POLICY
-from .evaluate import SUITES, evaluate_policy
+from . import protocol as proto_mod
+from .evaluate import SCENARIOS, describe_suite, evaluate_policy
 from .protocol_stats import bootstrap_mean_ci
 
 COLUMNS = [  # (key, header, format)
@@ -40,7 +41,8 @@ FREE_RESPONSE_ONLY = {"pendulum_zeta", "pendulum_period_s", "pitch_zeta", "pitch
 def comparison_table(results: list[dict], scenario: str) -> str:
     """Markdown table: one row per (wind speed, policy), averaged over the scenario's seeds
     (the gusty scenario shows no fitted damping: its response is forced, not free)."""
-    cols = [c for c in COLUMNS if scenario == "recover" or c[0] not in FREE_RESPONSE_ONLY]
+    free = scenario in SCENARIOS and SCENARIOS[scenario].free
+    cols = [c for c in COLUMNS if free or c[0] not in FREE_RESPONSE_ONLY]
     head = "| U [m/s] | policy | " + " | ".join(h for _, h, _ in cols) + " |"
     lines = [head, "|" + "---|" * (len(cols) + 2)]
     speeds = sorted({e["wind_speed"] for r in results for e in r["scenarios"][scenario]["episodes"]})
@@ -96,10 +98,15 @@ def verdicts(results: list[dict]) -> list[str]:
         for ref in ("passive", "lqr"):
             if ref not in by:
                 continue
+            if "recover" not in r["scenarios"]:
+                continue
             for e in r["scenarios"]["recover"]["episodes"]:
                 u = e["wind_speed"]
+                seed = e.get("seed", 0)
+                if seed != min(x.get("seed", 0) for x in r["scenarios"]["recover"]["episodes"]):
+                    continue  # one line per wind speed (several seeds: see protocol.md)
                 f = next(x for x in by[ref]["scenarios"]["recover"]["episodes"]
-                         if x["wind_speed"] == u)
+                         if x["wind_speed"] == u and x.get("seed", 0) == seed)
                 d = e["pendulum_zeta"] - f["pendulum_zeta"]
                 word = ("better" if d > ZETA_TOLERANCE else "worse" if d < -ZETA_TOLERANCE
                         else f"within the {ZETA_TOLERANCE} tolerance")
@@ -132,16 +139,20 @@ def plot(results: list[dict], out: Path) -> list[Path]:
     import matplotlib.pyplot as plt
 
     paths = []
+    if "recover" not in results[0]["scenarios"]:
+        return paths
     rec = results[0]["scenarios"]["recover"]["histories"]
-    speeds = rec.speeds
+    first = [i for i in range(len(rec.speeds)) if rec.seeds[i] == rec.seeds[0]]
+    speeds = rec.speeds[first]  # one episode per wind speed: the first seed's
     fig, axes = plt.subplots(3, len(speeds), figsize=(4.2 * len(speeds), 8), squeeze=False,
                              sharex=True)
     for j, u in enumerate(speeds):
         for r in results:
             h = r["scenarios"]["recover"]["histories"]
-            axes[0, j].plot(h.time, h.x[j], label=r["label"])
-            axes[1, j].plot(h.time, np.degrees(h.pitch[j]))
-            axes[2, j].plot(h.time, h.reel_speed[j])
+            i = first[j]
+            axes[0, j].plot(h.time, h.x[i], label=r["label"])
+            axes[1, j].plot(h.time, np.degrees(h.pitch[i]))
+            axes[2, j].plot(h.time, h.reel_speed[i])
         axes[0, j].set_title(f"recover, U = {u:g} m/s")
         axes[2, j].set_xlabel("time [s]")
     axes[0, 0].set_ylabel("along-wind displacement [m]")
@@ -155,7 +166,7 @@ def plot(results: list[dict], out: Path) -> list[Path]:
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     width = 0.8 / len(results)
     for k, r in enumerate(results):
-        eps = r["scenarios"]["recover"]["episodes"]
+        eps = [r["scenarios"]["recover"]["episodes"][i] for i in first]
         xs = np.arange(len(eps)) + k * width
         axes[0].bar(xs, [e["pendulum_zeta"] for e in eps], width, label=r["label"])
         axes[1].bar(xs, [e["pitch_zeta"] for e in eps], width, label=r["label"])
@@ -178,8 +189,8 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     parts = [f"# {title}", "", f"Command: `{command}`", "", *(preamble or []),
-             f"Suite `{results[0]['suite']}`: {json.dumps(SUITES[results[0]['suite']])} "
-             "(scenario: (wind speeds, seeds)). Control step 0.2 s.", "",
+             f"Suite `{results[0]['suite']}` (control step 0.2 s):", "",
+             describe_suite(results[0]["suite"]), "",
              "Scores (mean episode return, default reward): " +
              ", ".join(f"{r['label']} {r['score']:.0f}" for r in results) + ". " +
              score_and_damping(results), ""]
@@ -197,26 +208,53 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
     if "params_toml" in results[0]:
         (out / "params.toml").write_text(results[0]["params_toml"])
         parts += [f"Parameters: `params.toml` (tether {results[0]['tether_length_m']:g} m).", ""]
+    proto = protocol_for(results)
+    if proto is not None:
+        parts += ["Protocol tables (means and paired 95 % intervals over the seeds, aggregate "
+                  "IQM): `protocol.md`, data `protocol.json`.", ""]
+        (out / "protocol.md").write_text(
+            "\n".join([f"# Evaluation protocol: suite `{results[0]['suite']}`", "",
+                       f"Command: `{command}`", "", describe_suite(results[0]["suite"]), "",
+                       proto_mod.protocol_markdown(proto)]))
+        (out / "protocol.json").write_text(proto_mod.dumps(proto))
     md = out / "report.md"
     md.write_text("\n".join(parts))
-    (out / "report.json").write_text(json.dumps(jsonable(results), indent=1))
+    (out / "report.json").write_text(json.dumps(jsonable(results, proto), indent=1))
     return md
 
 
-def jsonable(results: list[dict]) -> list[dict]:
+def protocol_for(results: list[dict]) -> dict | None:
+    """The protocol's statistics (:func:`aerostat_gym.agents.protocol.protocol`) where they
+    mean something: the report suites, or two or more policies on a suite with two or more
+    seeds in some cell; else None."""
+    suite = results[0]["suite"]
+    seeds = max(len({e["seed"] for e in d["episodes"]})
+                for d in results[0]["scenarios"].values())
+    if suite.startswith("report") or (len(results) >= 2 and seeds >= 2):
+        return proto_mod.protocol(results)
+    return None
+
+
+def jsonable(results: list[dict], proto: dict | None = None) -> list[dict]:
     """The results as JSON-ready data: per scenario the episodes and, per wind speed, the mean
-    of every metric over the seeds with its 95 % bootstrap interval (``cells``)."""
+    of every metric over the seeds with its 95 % bootstrap interval (``cells``); with the
+    protocol's statistics ``proto``, per scenario also ``paired``: per wind speed the paired
+    differences of this policy against every baseline (metric -> diff, ci, verdict)."""
     out = []
     for r in results:
         r2 = {k: v for k, v in r.items() if k != "scenarios"}
         r2["scenarios"] = {s: {"episodes": d["episodes"], "cells": cell_means(d["episodes"])}
                            for s, d in r["scenarios"].items()}
+        if proto is not None:
+            for c in proto["cells"]:
+                r2["scenarios"][c["scenario"]].setdefault("paired", []).append(
+                    {"wind_speed": c["wind_speed"], **c["paired"].get(r["label"], {})})
         out.append(r2)
     return out
 
 
 #: Seeds from which a cell's interval is studentized (the protocol's default method).
-STUDENTIZED_MIN_SEEDS = 10
+STUDENTIZED_MIN_SEEDS = proto_mod.STUDENTIZED_MIN_SEEDS
 
 
 def cell_means(episodes: list[dict]) -> list[dict]:

@@ -8,7 +8,13 @@ import time
 
 from ..agents.evaluate import SUITES
 from ..agents.policies import load_policy
-from ..agents.report import comparison_table, jsonable, run_evaluations, write_report
+from ..agents.report import (
+    comparison_table,
+    jsonable,
+    protocol_for,
+    run_evaluations,
+    write_report,
+)
 from ..agents.train import ALGOS, train
 from ..analysis.modes import analyse
 from ..analysis.trim import find_equilibrium
@@ -53,7 +59,8 @@ def add_evaluate_parser(sub) -> None:
     p.add_argument("--policy", action="append", required=True,
                    help="passive, tension, lqr, shipped or PATH.zip (repeat to compare)")
     p.add_argument("--suite", choices=list(SUITES), default="tiny",
-                   help="frozen seed suite (scenario: wind speeds, seeds)")
+                   help="frozen seed suite (scenario: wind speeds, seeds); 'report' is the "
+                   "protocol of the README's baseline table (writes protocol.md)")
     p.add_argument("--out", default="runs/evaluate", help="report directory")
     p.add_argument("--json", action="store_true", help="print the metrics as JSON")
     p.add_argument("--no-plots", action="store_true", help="write no PNG plots")
@@ -67,11 +74,14 @@ def _evaluate_command(args) -> int:
     md = write_report(results, args.out, f"Evaluation on suite `{args.suite}`",
                       "aerostat-gym " + " ".join(sys.argv[1:]), plots=not args.no_plots)
     if args.json:
-        print(json.dumps(jsonable(results), indent=1))
+        print(json.dumps(jsonable(results, protocol_for(results)), indent=1))
     else:
         for scenario in results[0]["scenarios"]:
             print(f"{scenario}:\n{comparison_table(results, scenario)}\n")
         print(f"report (Markdown, plots, JSON): {md}")
+        if (md.parent / "protocol.md").is_file():
+            print(f"protocol (per-cell CIs, paired verdicts, aggregate IQM): "
+                  f"{md.parent / 'protocol.md'}")
     return 0
 
 
