@@ -2,7 +2,7 @@
 
 from .registration import ENV_ID, register
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 register()
 

@@ -1,10 +1,12 @@
-"""Does the environment's reward rank the winch baselines the way the pendulum damping does?
+"""Does the environment's reward (the winch-control score) rank the winch baselines the way the
+pendulum damping does?
 
-Runs the evaluator's ``recover`` scenario (steady wind, 10 m along-wind swing and 0.05 rad pitch
-kick, 180 s) for passive, tension feedback, LQR, modal and LQG at 3, 5, 7.5, 10, 12.5 and
-15 m/s, and per wind speed compares the episode return (the env's default reward) with the
-fitted pendulum damping ratio (single-mode and sinusoid-plus-drift fits) across the five
-policies: Spearman rank correlation, and whether the best-return policy is the best-damping one.
+Runs every free-response scenario of the evaluator (``recover``, ``recover_small``,
+``recover_cross``, ``recover_cross_small``, ``recover_combined``, ``recover_combined_small``) for
+passive, tension feedback, LQR, modal and LQG at 3, 5, 7.5, 10, 12.5 and 15 m/s
+(:mod:`aerostat_gym.agents.score_rank`), and per cell compares the episode return with the
+fitted damping of the swung pendulum: Spearman rank correlation across the five policies, and
+whether the best-return policy is the best-damping one.
 
 Usage::
 
@@ -16,54 +18,31 @@ from __future__ import annotations
 import argparse
 import json
 
-import numpy as np
-from scipy import stats
-
-from aerostat_gym.agents.evaluate import episode_metrics, run_scenario
-from aerostat_gym.agents.lqg import LQGPolicy
-from aerostat_gym.agents.lqr import LQRPolicy
-from aerostat_gym.agents.metrics_drift import fit_pendulum_with_drift
-from aerostat_gym.agents.modal import ModalPolicy
-from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy
+from aerostat_gym.agents.score_rank import rank_cells, rank_rows, summary
 from aerostat_gym.params import load_params
-
-SPEEDS = [3.0, 5.0, 7.5, 10.0, 12.5, 15.0]
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--json", default=None, help="write the per-episode figures here")
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--json", default=None, help="write the cells to this JSON file")
     args = ap.parse_args(argv)
-    params = load_params()
-    pols = {"passive": PassivePolicy(), "tension": TensionFeedbackPolicy(),
-            "lqr": LQRPolicy(params), "modal": ModalPolicy(params), "lqg": LQGPolicy(params)}
-    rows = []
-    for name, pol in pols.items():
-        ep = run_scenario(pol, "recover", SPEEDS, [0])
-        for i in range(len(SPEEDS)):
-            m = episode_metrics(ep, i)
-            drift = fit_pendulum_with_drift(ep.time, ep.x[i]).zeta
-            rows.append({"policy": name, "wind_speed": SPEEDS[i], "return": m["return"],
-                         "zeta": m["pendulum_zeta"], "zeta_drift": drift,
-                         "ended": m["ended"]})
-    print("| U [m/s] | returns (passive, tension, lqr, modal, lqg) | zeta drift fit | "
-          "Spearman(return, zeta) | best return = best zeta |\n|---|---|---|---|---|")
-    rhos, agree = [], 0
-    for U in SPEEDS:
-        cell = [r for r in rows if r["wind_speed"] == U]
-        ret = np.array([r["return"] for r in cell])
-        zd = np.array([r["zeta_drift"] for r in cell])
-        rho = float(stats.spearmanr(ret, zd).statistic)
-        same = int(np.argmax(ret) == np.argmax(zd))
-        rhos.append(rho)
-        agree += same
-        print(f"| {U:g} | {', '.join(f'{v:.1f}' for v in ret)} | "
-              f"{', '.join(f'{v:.3f}' for v in zd)} | {rho:.2f} | {'yes' if same else 'no'} |")
-    print(f"\nmean Spearman {np.mean(rhos):.2f}; best-return = best-damping in {agree} of "
-          f"{len(SPEEDS)} cells")
+    cells = rank_cells(rank_rows(load_params()))
+    print("| scenario | U [m/s] | returns (passive, tension, lqr, modal, lqg) | damping | "
+          "Spearman | best return = best damping |\n|---|---|---|---|---|---|")
+    for c in cells:
+        print(f"| {c['scenario']} | {c['wind_speed']:g} | "
+              f"{', '.join(f'{v:.1f}' for v in c['returns'])} | "
+              f"{', '.join(f'{v:.3f}' for v in c['zetas'])} | {c['rho']:.2f} | "
+              f"{'yes' if c['best_agrees'] else 'no'} |")
+    s = summary(cells)
+    print(f"\nmean Spearman {s['mean_rho']:.2f} over all {s['cells']} cells, "
+          f"{s['mean_rho_ranked']:.2f} over the {s['ranked_cells']} cells whose damping ratios "
+          f"span at least {s['min_span']:g}; best return = best damping in {s['best_agrees']} of "
+          f"{s['cells']}")
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump(rows, fh, indent=1)
+            json.dump({"cells": cells, "summary": s}, fh, indent=1)
 
 
 if __name__ == "__main__":

@@ -227,3 +227,25 @@ def test_aggregate_pools_the_cells_with_the_most_seeds():
     assert proto["aggregate_cells"] == ["gusty 10 m/s"]
     assert proto["aggregate"]["mine"]["iqm"] == pytest.approx(100.5 / -201.0)
     assert "1 of 2 cells with the most seeds" in protocol_markdown(proto)
+
+
+def test_condensed_view_marks_the_paired_verdicts():
+    """protocol_summary on a constructed two-policy cell: the mean and interval as printed, a
+    policy uniformly better than passive on RMS x marked with the up-triangle, and the aggregate
+    row present."""
+    from aerostat_gym.agents.protocol_summary import aggregate_table, metric_table
+
+    entry = {"mean": 5.0, "ci": [4.0, 6.0]}
+    cell = {"scenario": "gusty", "wind_speed": 8.0,
+            "policies": {"passive": {"rms_x_m": {"mean": 7.0, "ci": [7.0, 7.0]}},
+                         "lqr": {"rms_x_m": entry}},
+            "paired": {"lqr": {"passive": {"rms_x_m": {"verdict": "better"}}}}}
+    proto = {"cells": [cell],
+             "aggregate": {"passive": {"iqm": -1.0, "iqm_ci": [-1.1, -0.9],
+                                       "p_improvement": {"lqr": {"p": 0.2, "ci": [0.1, 0.3]}}},
+                           "lqr": {"iqm": -0.5, "iqm_ci": [-0.6, -0.4],
+                                   "p_improvement": {"passive": {"p": 0.8, "ci": [0.7, 0.9]}}}}}
+    table = metric_table(proto, [("gusty", "rms_x_m", 1.0, 1, (8.0,))])
+    assert table.splitlines()[2] == "| `gusty` | 8 | 7.0 | 5.0 [4.0, 6.0] ▲ |"
+    agg = aggregate_table(proto).splitlines()
+    assert agg[3] == "| lqr | -0.500 [-0.600, -0.400] | 0.80 [0.70, 0.90] | - |"

@@ -1,9 +1,11 @@
-"""The README's environment example runs as printed."""
+"""The README's examples run as printed."""
 
 from __future__ import annotations
 
 import re
 from pathlib import Path
+
+import pytest
 
 
 def test_readme_environment_example_runs():
@@ -14,3 +16,32 @@ def test_readme_environment_example_runs():
     exec(compile(blocks[0], "README.md", "exec"), namespace)  # noqa: S102
     assert namespace["truncated"] or namespace["terminated"]
     assert namespace["obs"].shape == (19,)
+
+
+def _sb3_example() -> str:
+    """The README's SB3 example: the python block under "A short SB3 run"."""
+    text = (Path(__file__).parent.parent / "README.md").read_text()
+    section = text.split("**A short SB3 run.**", 1)[1]
+    return re.search(r"```python\n(.*?)```", section, flags=re.S).group(1)
+
+
+def test_readme_sb3_example_is_short_and_complete():
+    """At most 20 lines of code (as the README promises), trains on a registered task and
+    compares with the braked winch on held-out seeds."""
+    code = [ln for ln in _sb3_example().splitlines() if ln.strip() and not ln.startswith("#")]
+    assert len(code) <= 20
+    src = "\n".join(code)
+    assert "TetheredAerostatDamping-v0" in src and "task_returns" in src and '"passive"' in src
+
+
+@pytest.mark.slow
+def test_readme_sb3_example_beats_the_braked_winch(tmp_path, monkeypatch):
+    """The README's SB3 example, run as printed (1 M steps, about 1.5-3 min on 2 cores): its
+    mean return over the 20 held-out seeds beats the braked winch's, the paired 95 % interval
+    excluding zero (measured when written: -48.2 against -88.0, difference +39.8
+    [+9.9, +303.1])."""
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(_sb3_example(), "README.md", "exec"), namespace)  # noqa: S102
+    diff = namespace["diff"]
+    assert diff.n == 20 and diff.low > 0.0, diff

@@ -27,12 +27,23 @@ DESCRIPTION = ("Tethered-aerostat simulator (Lambert & Nahon 2002), linear stabi
                "winch-control agents. Run 'aerostat-gym COMMAND --help' for a command's options.")
 
 
+class DefaultsFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Appends "(default: ...)" to an option's help unless the help already says what the
+    default is (e.g. "default: the YAML's"), so no option shows two defaults."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "default" in text.lower():
+            return text
+        return super()._get_help_string(action)
+
+
 class Parser(OneLineParser):
     """Every command's parser shows each option's default in its help, and reports a bad
     option as one line on stderr with exit status 2."""
 
     def __init__(self, *args, **kwargs):
-        kwargs.setdefault("formatter_class", argparse.ArgumentDefaultsHelpFormatter)
+        kwargs.setdefault("formatter_class", DefaultsFormatter)
         super().__init__(*args, **kwargs)
 
 

@@ -1,0 +1,27 @@
+"""Condensed Markdown tables of a report-suite evaluation (the README's view of
+``protocol.json``): pendulum and pitch damping, RMS displacement and peak tension per cell with
+intervals and paired verdicts against passive, and the aggregate.
+
+Usage::
+
+    PYTHONPATH=. python scripts/protocol_readme.py agents/baseline_report/protocol.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from aerostat_gym.agents.protocol_summary import condensed
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("protocol_json", help="protocol.json written by aerostat-gym evaluate")
+    args = ap.parse_args(argv)
+    with open(args.protocol_json) as fh:
+        print(condensed(json.load(fh)))
+
+
+if __name__ == "__main__":
+    main()
