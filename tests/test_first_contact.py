@@ -62,14 +62,18 @@ def test_registered_tasks_reproduce_their_conditions(task_id):
 
 
 def test_shipped_policy_trained_on_its_registered_task():
-    """The shipped PPO's hyperparameter block is keyed by the task it was trained on, whose
-    registered kwargs equal the conditions recorded with the training run."""
+    """The shipped PPO was trained by this package version on the task its hyperparameter block
+    is keyed by: the recorded run's block equals the shipped YAML's, its summary names the same
+    task, and its version record is this package's version (so gym.make(task_id) is the
+    training environment, reward and winch logic included)."""
     task_id, hp, project = load_hyperparams("ppo")
     assert task_id == "TetheredAerostatDamping-v0"
-    recorded = yaml.safe_load((ROOT / "agents" / "ppo_training" / "hyperparams.yml").read_text())
-    assert recorded["TetheredAerostat-v0"]["env_kwargs"] == TASKS[task_id][0]
-    # the normalisation is the one the shipped run used (gamma added as the zoo does)
-    assert normalize_kwargs(hp) == recorded["TetheredAerostat-v0"]["normalize"]
+    run = ROOT / "agents" / "ppo_training"
+    recorded = yaml.safe_load((run / "hyperparams.yml").read_text())
+    assert set(recorded) == {task_id, "aerostat_gym"}
+    assert recorded[task_id] == hp and recorded["aerostat_gym"] == project
+    assert json.loads((run / "training_summary.json").read_text())["task"] == task_id
+    assert json.loads((run / "version.json").read_text())["aerostat_gym"] == aerostat_gym.__version__
     assert project == {"eval_freq": 100000, "eval_suite": "damping"}
 
 

@@ -131,6 +131,34 @@ def score_and_damping(results: list[dict]) -> str:
             "(reward terms `length`, `effort`, `effort_rate`), which the damping ratio ignores.")
 
 
+def plot_training_curve(history: list[dict], out: Path, title: str = "") -> Path:
+    """The training curve: suite score (mean return on the evaluation suite) against
+    environment steps and against wall time, from ``evaluations.json``'s records."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    steps = np.array([h["timesteps"] for h in history], float)
+    wall = np.array([h["wall_time_s"] for h in history], float)
+    score = np.array([h["score"] for h in history], float)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), sharey=True)
+    axes[0].plot(steps / 1e6, score, "o-", ms=3)
+    axes[0].set_xlabel("environment steps [millions]")
+    axes[1].plot(wall, score, "o-", ms=3)
+    axes[1].set_xlabel("wall time [s]")
+    axes[0].set_ylabel("suite score (mean return)")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    path = Path(out) / "training_curve.png"
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
 def plot(results: list[dict], out: Path) -> list[Path]:
     """Time histories of every policy overlaid (recover scenario) and damping ratios side by side."""
     import matplotlib

@@ -30,6 +30,7 @@ from ..params import dumps_toml
 from ..registration import TASKS
 from ..resources import shipped_path
 from .evaluate import check_suite, suite_score
+from .report import plot_training_curve
 from .sb3io import SB3Policy, save_model, vecnormalize_path
 
 ALGOS = ("ppo", "sac", "td3")
@@ -169,6 +170,9 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
                "machine": platform.processor() or platform.machine(),
                "threads": torch.get_num_threads()}
     (run / "training_summary.json").write_text(json.dumps(summary, indent=2))
+    if suite_cb.history:
+        plot_training_curve(suite_cb.history, run, f"{algo} on {task_id}, seed {seed}: score on "
+                            f"the '{project.get('eval_suite', 'tiny')}' suite")
     venv.close()
     return run
 
