@@ -145,6 +145,7 @@ def test_bad_input_is_one_line_on_stderr(tmp_path, args, needle):
 
 
 def test_help_has_defaults_and_no_markup():
+    """No RST markup in --help; every option documented, its default shown once."""
     from aerostat_gym.cli import build_parser
 
     text = build_parser().format_help()
@@ -153,3 +154,11 @@ def test_help_has_defaults_and_no_markup():
     assert "(default: shipped)" in sub["demo"].format_help()
     assert "(default: tiny)" in sub["evaluate"].format_help()
     assert aerostat_gym.__version__
+    # every option of every command has a help text, and none shows two defaults
+    for name, parser in sub.items():
+        formatter = parser._get_formatter()
+        for action in parser._actions:
+            if action.option_strings and action.dest != "help":
+                assert action.help, (name, action.option_strings)
+                shown = formatter._get_help_string(action).lower()
+                assert shown.count("default:") + shown.count("(default ") <= 1, (name, shown)

@@ -63,7 +63,7 @@ def add_model_parsers(sub) -> None:
     add_config(p)
     p.set_defaults(func=cmd_params)
     p = sub.add_parser("bench", help="speed and accuracy figures")
-    p.add_argument("--json", action="store_true")
+    p.add_argument("--json", action="store_true", help="print the figures as JSON")
     p.add_argument("--quick", action="store_true", help="shorter runs (smoke test)")
     p.add_argument("--moordyn-dynamic", action="store_true",
                    help="only the dynamic comparison with MoorDyn (driven top end)")

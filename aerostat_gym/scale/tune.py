@@ -471,7 +471,7 @@ def add_tune_arguments(p: argparse.ArgumentParser) -> None:
     ----------
     p : the tune subparser.
     """
-    p.add_argument("--algo", choices=ALGOS, default="ppo")
+    p.add_argument("--algo", choices=ALGOS, default="ppo", help="Stable-Baselines3 algorithm")
     p.add_argument("--hyperparams", metavar="YAML",
                    help="base hyperparameter file (default: the shipped hyperparams/ALGO.yml)")
     p.add_argument("--space", required=True,
@@ -479,14 +479,17 @@ def add_tune_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4],
                    help="training seeds; every configuration runs each (default 0-4)")
     p.add_argument("--configs", type=int, default=4, help="configurations to try (default 4)")
-    p.add_argument("--searcher", choices=SEARCHERS, default="optuna")
-    p.add_argument("--scheduler", choices=SCHEDULERS, default="fifo")
+    p.add_argument("--searcher", choices=SEARCHERS, default="optuna",
+                   help="how configurations are proposed (Ray Tune search algorithm)")
+    p.add_argument("--scheduler", choices=SCHEDULERS, default="fifo",
+                   help="trial scheduler (fifo: every trial runs to the end)")
     p.add_argument("--search-seed", type=int, default=0, help="seed of the sampler")
     p.add_argument("--timesteps", type=int, help="steps per trial (default: the YAML)")
     p.add_argument("--n-envs", type=int, help="environments per trial (default: the YAML)")
     p.add_argument("--eval-freq", type=int, help="steps between suite evaluations (default: "
                    "the YAML)")
-    p.add_argument("--cpus-per-trial", type=float, default=1.0)
+    p.add_argument("--cpus-per-trial", type=float, default=1.0,
+                   help="CPUs Ray reserves for each trial")
     p.add_argument("--threads", type=int, default=1, help="torch / numba threads per trial")
     p.add_argument("--address", help="join this Ray cluster instead of starting a local one")
     p.add_argument("--workers", type=int, help="CPUs of the local Ray instance (default: all)")
