@@ -86,6 +86,8 @@ def test_smoke_training_is_deterministic_and_reloads(tmp_path, variant):
     if "residual" in project:
         assert meta["residual"] == {**project["residual"], "obs_noise": 0.01}
     assert json.loads((runs[0] / "training_summary.json").read_text())["wrappers"] == meta
+    # a checkpoint (none is written at eval_freq 1e9: the name of one) finds the run's metadata
+    assert read_wrappers(runs[0] / "checkpoints" / f"{algo}_1000_steps.zip") == meta
 
 
 @pytest.mark.parametrize("variant", ["stack-ppo", "residual-ppo", "rppo"])
@@ -212,3 +214,25 @@ def test_normalisation_floor_on_a_channel_constant_in_training():
                                              np.zeros(1000)]))
         out = norm.normalize_obs(np.array([[0.0, 0.01]], np.float32))
         assert out[0, 1] == pytest.approx(expected, rel=1e-3)
+
+
+def test_cli_evaluate_rebuilds_stack_and_residual(tmp_path):
+    """``aerostat-gym evaluate --policy RUN/ppo_final.zip`` on a model trained with both a frame
+    stack and a residual base scores the damping suite exactly as the training run's last
+    evaluation did."""
+    from aerostat_gym.cli import main
+
+    config = tmp_path / "both.yml"
+    config.write_text(yaml.safe_dump({TASK: VARIANTS["ppo"][1], "aerostat_gym": {
+        "eval_suite": "damping", "env_kwargs": SMOKE_ENV, "frame_stack": 2,
+        "residual": {"base": "lqg", "scale": 0.5}}}))
+    run = train("ppo", config, timesteps=512, seed=5, run_dir=tmp_path / "r", progress_bar=False,
+                threads=1, eval_freq=10**9)
+    last = json.loads((run / "evaluations.json").read_text())[-1]["score"]
+    assert read_wrappers(run / "ppo_final.zip") == {
+        "frame_stack": 2, "residual": {"base": "lqg", "scale": 0.5, "obs_noise": 0.01}}
+    assert main(["evaluate", "--policy", str(run / "ppo_final.zip"), "--suite", "damping",
+                 "--out", str(tmp_path / "ev"), "--no-plots"]) == 0
+    rows = json.loads((tmp_path / "ev" / "report.json").read_text())
+    returns = [e["return"] for e in rows[0]["scenarios"]["recover"]["episodes"]]
+    assert float(np.mean(returns)) == pytest.approx(last, rel=1e-12)

@@ -25,6 +25,8 @@ from ..envs.spaces import N_OBS
 
 VECNORM_SUFFIX = "_vecnormalize.pkl"
 WRAPPERS_SUFFIX = "_wrappers.json"
+#: Wrapper metadata of every model in a folder (a run's checkpoints/).
+FOLDER_WRAPPERS = "wrappers.json"
 
 
 class PolicyError(ValueError):
@@ -78,9 +80,15 @@ def save_model(model, path: Path, wrappers: dict | None = None) -> None:
     norm = find_vecnormalize(model.get_env())
     if norm is not None:
         norm.save(str(vecnormalize_path(path)))
+    write_wrappers(wrappers_path(path), wrappers)
+
+
+def write_wrappers(path: Path, wrappers: dict | None) -> None:
+    """Write the wrapper metadata worth saving (nothing for a plain model)."""
     wrappers = clean_wrappers(wrappers)
     if wrappers:
-        wrappers_path(path).write_text(json.dumps(wrappers, indent=2) + "\n")
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        Path(path).write_text(json.dumps(wrappers, indent=2) + "\n")
 
 
 def clean_wrappers(wrappers: dict | None) -> dict:
@@ -170,8 +178,11 @@ def _algorithms() -> list:
 
 
 def read_wrappers(path: str | Path) -> dict:
-    """The wrapper metadata saved beside a model ({} when it has none)."""
+    """The wrapper metadata saved beside a model ({} when it has none): ``<stem>_wrappers.json``
+    or, for the checkpoints of a run, the folder's :data:`FOLDER_WRAPPERS`."""
     meta = wrappers_path(Path(path))
+    if not meta.is_file():
+        meta = Path(path).with_name(FOLDER_WRAPPERS)
     if not meta.is_file():
         return {}
     try:

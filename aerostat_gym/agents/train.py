@@ -31,7 +31,8 @@ deviation of at least 0.01 in the observation's scaled units: the sensor noise l
 Each run directory holds the resolved parameter TOML, the hyperparameters, the command, the
 package version, TensorBoard logs, checkpoints (model + VecNormalize statistics), the best
 model on the fixed evaluation suite and the final model; a model trained with a frame stack or
-a residual base has ``<stem>_wrappers.json`` beside it, which ``load_policy`` (and so
+a residual base has ``<stem>_wrappers.json`` beside it (its checkpoints: ``checkpoints/
+wrappers.json``), which ``load_policy`` (and so
 ``aerostat-gym evaluate --policy``) reads to rebuild the same stack and base.
 """
 
@@ -57,12 +58,14 @@ from .evaluate import check_suite, suite_score
 from .policies import load_policy
 from .residual import check_residual, residual_vec_env
 from .sb3io import (
+    FOLDER_WRAPPERS,
     PolicyError,
     SB3Policy,
     clean_wrappers,
     find_vecnormalize,
     save_model,
     vecnormalize_path,
+    write_wrappers,
 )
 
 ALGOS = ("ppo", "sac", "td3", "rppo")
@@ -244,6 +247,7 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     freq = int(eval_freq or project.get("eval_freq", 50_000))
     suite_cb = suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1),
                                    run, env_kwargs.get("params"), on_eval, wrappers, base)
+    write_wrappers(run / "checkpoints" / FOLDER_WRAPPERS, wrappers)
     callbacks = [CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"),
                                     name_prefix=algo, save_vecnormalize=True), suite_cb]
     if progress_bar:
