@@ -25,6 +25,7 @@ from ..resources import SHIPPED_POLICY, shipped_path
 from .lqg import LQGPolicy
 from .lqr import LQRPolicy
 from .modal import ModalPolicy
+from .residual import check_residual
 from .sb3io import PolicyError, as_batch, load_sb3, to_actions
 
 BASELINES = ("passive", "tension", "lqr", "modal", "lqg")
@@ -99,8 +100,17 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     LQR over the wind range, privileged full state), 'modal' (pendulum pole placement,
     privileged full state), 'lqg' (Kalman filter on the standard channels designed for the
     sensor noise ``obs_noise``, with the LQR gains).
+
+    A saved model's wrapper metadata (``<stem>_wrappers.json``) is honoured: its frame stack,
+    and its residual base rebuilt for ``params`` and ``dt`` with the sensor noise it was
+    trained with.
     """
     params = params or load_params()
+
+    def base_factory(base: str, noise: float):
+        check_residual({"base": base})
+        return load_policy(base, params=params, dt=dt, wind_range=wind_range, obs_noise=noise)
+
     if name == "passive":
         return PassivePolicy()
     if name == "tension":
@@ -112,8 +122,8 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     if name == "lqg":
         return LQGPolicy(params, dt=dt, obs_noise=obs_noise)
     if name in SHIPPED:
-        return load_sb3(shipped_path(SHIPPED[name]))
+        return load_sb3(shipped_path(SHIPPED[name]), base_factory)
     if name.endswith(".zip") or Path(name).exists():
-        return load_sb3(name)
+        return load_sb3(name, base_factory)
     raise PolicyError(f"unknown policy {name!r}: use one of {BASELINES + tuple(SHIPPED)} or a "
                       "path to a .zip")

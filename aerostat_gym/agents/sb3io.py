@@ -1,12 +1,19 @@
 """Stable-Baselines3 input and output: saving and loading trained models with their
-VecNormalize statistics, and the :class:`SB3Policy` that runs one like a baseline.
+VecNormalize statistics and wrapper stack, and the :class:`SB3Policy` that runs one like a
+baseline.
 
-Stable-Baselines3 is an optional dependency (the ``train`` extra): it is imported inside the
-functions that need it.
+A model trained with wrappers beyond VecNormalize (``frame_stack``, ``residual``: see
+:mod:`aerostat_gym.agents.train`) is saved with ``<stem>_wrappers.json`` beside it
+(:func:`wrappers_path`), ``{"frame_stack": K, "residual": {"base": ..., "scale": ...,
+"obs_noise": ...}}``, so that loading it rebuilds the same observation stack and base policy.
+
+Stable-Baselines3 (and sb3-contrib, for RecurrentPPO) are optional dependencies (the ``train``
+extra): they are imported inside the functions that need them.
 """
 
 from __future__ import annotations
 
+import json
 import pickle
 import warnings
 import zipfile
@@ -17,6 +24,9 @@ import numpy as np
 from ..envs.spaces import N_OBS
 
 VECNORM_SUFFIX = "_vecnormalize.pkl"
+WRAPPERS_SUFFIX = "_wrappers.json"
+#: Wrapper metadata of every model in a folder (a run's checkpoints/).
+FOLDER_WRAPPERS = "wrappers.json"
 
 
 class PolicyError(ValueError):
@@ -46,40 +56,145 @@ def vecnormalize_path(model_path: Path) -> Path:
     return model_path.with_name(stem + VECNORM_SUFFIX)
 
 
-def save_model(model, path: Path) -> None:
-    """Save the model and, if it trains on a VecNormalize, its statistics beside it."""
+def wrappers_path(model_path: Path) -> Path:
+    """Where the wrapper metadata of a saved model lives: ``<stem>_wrappers.json``."""
+    model_path = Path(model_path)
+    return model_path.with_name(model_path.stem + WRAPPERS_SUFFIX)
+
+
+def find_vecnormalize(venv):
+    """The VecNormalize in a wrapper chain (None if there is none)."""
     from stable_baselines3.common.vec_env import VecNormalize
 
+    while venv is not None:
+        if isinstance(venv, VecNormalize):
+            return venv
+        venv = getattr(venv, "venv", None)
+    return None
+
+
+def save_model(model, path: Path, wrappers: dict | None = None) -> None:
+    """Save the model, the statistics of the VecNormalize in its environment's wrapper chain (if
+    any) and, when ``wrappers`` has a frame stack or a residual base, their metadata beside it."""
     model.save(str(path))
-    env = model.get_env()
-    if isinstance(env, VecNormalize):
-        env.save(str(vecnormalize_path(path)))
+    norm = find_vecnormalize(model.get_env())
+    if norm is not None:
+        norm.save(str(vecnormalize_path(path)))
+    write_wrappers(wrappers_path(path), wrappers)
+
+
+def write_wrappers(path: Path, wrappers: dict | None) -> None:
+    """Write the wrapper metadata worth saving (nothing for a plain model)."""
+    wrappers = clean_wrappers(wrappers)
+    if wrappers:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        Path(path).write_text(json.dumps(wrappers, indent=2) + "\n")
+
+
+def clean_wrappers(wrappers: dict | None) -> dict:
+    """The metadata worth saving: a frame stack of more than one frame, a residual base."""
+    out = {}
+    if wrappers and int(wrappers.get("frame_stack") or 1) > 1:
+        out["frame_stack"] = int(wrappers["frame_stack"])
+    if wrappers and wrappers.get("residual"):
+        out["residual"] = dict(wrappers["residual"])
+    return out
+
+
+def _is_recurrent(model) -> bool:
+    return type(model).__name__ == "RecurrentPPO"
 
 
 class SB3Policy:
     """A Stable-Baselines3 model and (optionally) the VecNormalize whose statistics it was
-    trained with; observations are normalised the same way before ``model.predict``."""
+    trained with; observations are normalised the same way before ``model.predict``.
 
-    def __init__(self, model, vecnormalize=None):
+    ``frame_stack`` K > 1 stacks the last K normalised observations (oldest first, the
+    newest last, zeros before the episode's first step: SB3's VecFrameStack on top of
+    VecNormalize). ``residual`` = (base policy, scale) adds the model's action times scale to
+    the base policy's (which reads the raw observation and keeps its own state), clipped to
+    [-1, 1]. The state passed back and forth is then a dict of the recurrent model's state,
+    the stack and the base policy's state; ``episode_start`` resets all three.
+    """
+
+    def __init__(self, model, vecnormalize=None, frame_stack: int = 1, residual=None):
         from stable_baselines3.common.vec_env import VecNormalize
 
         self.model = model
         self.norm = vecnormalize if isinstance(vecnormalize, VecNormalize) else None
-        self.obs_dim = int(model.observation_space.shape[0])
+        self.frame_stack = int(frame_stack)
+        self.residual = residual
+        self.recurrent = _is_recurrent(model)
+        self.obs_dim = int(model.observation_space.shape[0]) // self.frame_stack
+        self.plain = self.frame_stack == 1 and residual is None and not self.recurrent
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs, single = as_batch(observation)
+        raw = obs
         if self.norm is not None:
             obs = self.norm.normalize_obs(obs)
-        a, _ = self.model.predict(obs, deterministic=deterministic)
-        return to_actions(np.asarray(a).reshape(-1), single), state
+        if self.plain:
+            a, _ = self.model.predict(obs, deterministic=deterministic)
+            return to_actions(np.asarray(a).reshape(-1), single), state
+        n = len(obs)
+        state = dict(state) if isinstance(state, dict) else {}
+        start = (np.ones(n, bool) if episode_start is None and not state
+                 else np.zeros(n, bool) if episode_start is None
+                 else np.broadcast_to(np.asarray(episode_start, bool).reshape(-1), (n,)).copy())
+        if self.frame_stack > 1:
+            d = obs.shape[1]
+            stack = state.get("stack")
+            if stack is None or stack.shape != (n, d * self.frame_stack):
+                stack = np.zeros((n, d * self.frame_stack), np.float32)
+            stack = np.roll(stack, -d, axis=1)
+            stack[start] = 0.0
+            stack[:, -d:] = obs
+            state["stack"] = stack
+            obs = stack
+        if self.recurrent:
+            a, state["lstm"] = self.model.predict(obs, state=state.get("lstm"),
+                                                  episode_start=start,
+                                                  deterministic=deterministic)
+        else:
+            a, _ = self.model.predict(obs, deterministic=deterministic)
+        a = np.asarray(a, np.float64).reshape(-1)
+        if self.residual is not None:
+            base, scale = self.residual
+            b, state["base"] = base.predict(raw, state=state.get("base"), episode_start=start,
+                                            deterministic=True)
+            a = np.asarray(b, np.float64).reshape(-1) + scale * np.clip(a, -1.0, 1.0)
+        return to_actions(a, single), state
 
 
-def load_sb3(path: str | Path) -> SB3Policy:
-    """Load a saved model (+ its ``_vecnormalize.pkl``); clear errors for a missing or corrupt
-    file."""
+def _algorithms() -> list:
     from stable_baselines3 import PPO, SAC, TD3
 
+    algos = [PPO, SAC, TD3]
+    try:
+        from sb3_contrib import RecurrentPPO
+    except ImportError:  # sb3-contrib is optional: its models then fail to load, clearly
+        return algos
+    return algos + [RecurrentPPO]
+
+
+def read_wrappers(path: str | Path) -> dict:
+    """The wrapper metadata saved beside a model ({} when it has none): ``<stem>_wrappers.json``
+    or, for the checkpoints of a run, the folder's :data:`FOLDER_WRAPPERS`."""
+    meta = wrappers_path(Path(path))
+    if not meta.is_file():
+        meta = Path(path).with_name(FOLDER_WRAPPERS)
+    if not meta.is_file():
+        return {}
+    try:
+        return clean_wrappers(json.loads(meta.read_text()))
+    except (ValueError, TypeError, AttributeError) as exc:
+        raise PolicyError(f"cannot read the wrapper metadata {meta}: {exc}") from None
+
+
+def load_sb3(path: str | Path, base_factory=None) -> SB3Policy:
+    """Load a saved model (+ its ``_vecnormalize.pkl`` and ``_wrappers.json``); clear errors
+    for a missing or corrupt file. ``base_factory(name, obs_noise)`` builds the base policy of
+    a residual model (required for one)."""
     path = Path(path)
     if not path.is_file():
         raise PolicyError(f"policy file not found: {path}")
@@ -87,14 +202,16 @@ def load_sb3(path: str | Path) -> SB3Policy:
         raise PolicyError(f"{path} is not a Stable-Baselines3 model (.zip archive): corrupt or "
                           "wrong file")
     errors = []
-    for Algo in (PPO, SAC, TD3):
+    algos = _algorithms()
+    for Algo in algos:
         try:
             model = Algo.load(str(path), device="cpu")
             break
         except Exception as exc:  # noqa: BLE001 - try the next algorithm, report all
             errors.append(f"{Algo.__name__}: {type(exc).__name__}: {exc}"[:200])
     else:
-        raise PolicyError(f"cannot load {path} as a PPO, SAC or TD3 model: " + "; ".join(errors))
+        names = ", ".join(a.__name__ for a in algos)
+        raise PolicyError(f"cannot load {path} as a {names} model: " + "; ".join(errors))
     norm = None
     stats = vecnormalize_path(path)
     if stats.is_file():
@@ -105,8 +222,19 @@ def load_sb3(path: str | Path) -> SB3Policy:
         warnings.warn(f"no VecNormalize statistics beside {path} (looked for {stats.name}): the "
                       "policy sees raw observations, which is wrong if it was trained with "
                       "normalisation", stacklevel=2)
+    wrappers = read_wrappers(path)
+    k = wrappers.get("frame_stack", 1)
     shape = model.observation_space.shape
-    if len(shape) != 1 or shape[0] < N_OBS:
-        raise PolicyError(f"{path} was trained on observations of shape {shape}; "
+    if len(shape) != 1 or shape[0] % k or shape[0] // k < N_OBS:
+        stacked = f" ({k} stacked frames)" if k > 1 else ""
+        raise PolicyError(f"{path} was trained on observations of shape {shape}{stacked}; "
                           f"TetheredAerostat-v0 gives ({N_OBS},) (standard) or the full layout")
-    return SB3Policy(model, norm)
+    residual = None
+    if "residual" in wrappers:
+        spec = wrappers["residual"]
+        if base_factory is None:
+            raise PolicyError(f"{path} is a residual policy on {spec.get('base')!r}: load it "
+                              "with load_policy, which builds the base policy")
+        residual = (base_factory(spec["base"], float(spec.get("obs_noise", 0.0))),
+                    float(spec["scale"]))
+    return SB3Policy(model, norm, frame_stack=k, residual=residual)

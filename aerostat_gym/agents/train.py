@@ -5,10 +5,35 @@ per registered task id (keys ``n_timesteps``, ``n_envs``, ``policy``, ``normaliz
 the zoo's string ``"dict(norm_obs=..., norm_reward=...)"``; the discount ``gamma`` is added, as
 the zoo does), ``policy_kwargs``, ``noise_type`` / ``noise_std`` for TD3, the rest passed to the
 algorithm), trained on that task's registered conditions. Keys the zoo does not know live in a
-separate top-level block ``aerostat_gym`` (``eval_freq``, ``eval_suite``, ``env_kwargs``).
+separate top-level block ``aerostat_gym``:
+
+- ``eval_freq``: environment steps between evaluations on the suite; ``eval_suite``: its name;
+  ``env_kwargs``: environment arguments over the task's registered ones (e.g. ``turbulence``,
+  ``perturbation``, ``randomize: true``, ``obs_noise``).
+- ``frame_stack: K``: the policy sees the last K (normalised) observations, SB3's
+  VecFrameStack on top of VecNormalize (the zoo's order), so that a feed-forward policy can
+  see the pendulum's phase and rate.
+- ``residual: {base: lqg, scale: 0.3}``: the action sent to the environment is
+  clip(base + scale * action, -1, 1), with ``base`` a baseline that reads the standard
+  observation (``lqg`` or ``tension``; the privileged ``lqr`` and ``modal`` are refused),
+  designed for the training configuration and the training sensor noise, keeping its own
+  state and reset at every episode start (:mod:`aerostat_gym.agents.residual`).
+
+Algorithms: ``ppo``, ``sac``, ``td3`` (Stable-Baselines3) and ``rppo`` (sb3-contrib's
+RecurrentPPO, an LSTM policy, ``policy: MlpLstmPolicy``).
+
+Normalisation: VecNormalize divides by sqrt(var + epsilon) and clips at ``clip_obs`` (10).
+A channel constant in training (wind_y, wind_z in calm air: var ~ 3e-11) then has a scale of
+1e-4, so any movement at evaluation saturates it at +-10. Give a floor with the zoo's own
+key, ``normalize: "dict(norm_obs=True, norm_reward=True, epsilon=1.0e-4)"`` (a standard
+deviation of at least 0.01 in the observation's scaled units: the sensor noise level).
+
 Each run directory holds the resolved parameter TOML, the hyperparameters, the command, the
 package version, TensorBoard logs, checkpoints (model + VecNormalize statistics), the best
-model on the fixed evaluation suite and the final model.
+model on the fixed evaluation suite and the final model; a model trained with a frame stack or
+a residual base has ``<stem>_wrappers.json`` beside it (its checkpoints: ``checkpoints/
+wrappers.json``), which ``load_policy`` (and so
+``aerostat-gym evaluate --policy``) reads to rebuild the same stack and base.
 """
 
 from __future__ import annotations
@@ -26,19 +51,30 @@ import numpy as np
 
 from .. import __version__
 from ..envs.sb3 import sb3_vec_env
-from ..params import dumps_toml
+from ..params import Params, dumps_toml, load_params
 from ..registration import TASKS
 from ..resources import shipped_path
 from .evaluate import check_suite, suite_score
+from .policies import load_policy
 from .report import plot_training_curve
-from .sb3io import SB3Policy, save_model, vecnormalize_path
+from .residual import check_residual, residual_vec_env
+from .sb3io import (
+    FOLDER_WRAPPERS,
+    PolicyError,
+    SB3Policy,
+    clean_wrappers,
+    find_vecnormalize,
+    save_model,
+    vecnormalize_path,
+    write_wrappers,
+)
 
-ALGOS = ("ppo", "sac", "td3")
+ALGOS = ("ppo", "sac", "td3", "rppo")
 #: Keys of a zoo block that configure the run rather than the algorithm's constructor.
 RESERVED = {"n_timesteps", "n_envs", "policy", "normalize", "noise_type", "noise_std",
             "policy_kwargs"}
 PROJECT_BLOCK = "aerostat_gym"
-PROJECT_KEYS = {"eval_freq", "eval_suite", "env_kwargs"}
+PROJECT_KEYS = {"eval_freq", "eval_suite", "env_kwargs", "frame_stack", "residual"}
 
 
 class TrainingError(ValueError):
@@ -95,20 +131,72 @@ def normalize_kwargs(hp: dict) -> dict | None:
 
 
 def _algorithm(algo: str):
+    if algo == "rppo":
+        from sb3_contrib import RecurrentPPO
+
+        return RecurrentPPO
     from stable_baselines3 import PPO, SAC, TD3
 
     return {"ppo": PPO, "sac": SAC, "td3": TD3}[algo]
 
 
-def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict | None):
-    """The SB3 VecEnv over one compiled batch, wrapped in VecMonitor and (with VecNormalize
-    keyword arguments) VecNormalize."""
-    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+def wrapper_spec(project: dict, env_kwargs: dict) -> dict:
+    """The validated wrapper options of a project block: {"frame_stack": K, "residual":
+    {"base", "scale", "obs_noise"}} (the residual's sensor noise is the training
+    environment's, which its base is designed for)."""
+    k = project.get("frame_stack", 1)
+    if isinstance(k, bool) or not isinstance(k, int) or not 1 <= k <= 64:
+        raise TrainingError(f"frame_stack must be an integer in [1, 64], got {k!r}")
+    spec = {"frame_stack": k}
+    if project.get("residual") is not None:
+        try:
+            res = check_residual(project["residual"])
+        except PolicyError as exc:
+            raise TrainingError(str(exc)) from None
+        spec["residual"] = {**res, "obs_noise": float(env_kwargs.get("obs_noise", 0.0))}
+    return spec
 
+
+def residual_base(spec: dict, env_kwargs: dict):
+    """The base policy of a residual spec, designed for the training configuration (None
+    without a residual)."""
+    res = spec.get("residual")
+    if not res:
+        return None
+    params = env_kwargs.get("params")
+    params = params if isinstance(params, Params) else load_params(params)
+    return load_policy(res["base"], params=params, dt=float(env_kwargs.get("control_step", 0.2)),
+                       obs_noise=res["obs_noise"])
+
+
+def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict | None,
+                      wrappers: dict | None = None, base=None, stats=None):
+    """The SB3 VecEnv over one compiled batch, wrapped in VecMonitor, (with a residual spec in
+    ``wrappers``) the residual wrapper on ``base``, (with VecNormalize keyword arguments)
+    VecNormalize, its statistics loaded from ``stats`` if that file is given, and (with
+    ``frame_stack`` > 1) VecFrameStack."""
+    from stable_baselines3.common.vec_env import VecFrameStack, VecMonitor, VecNormalize
+
+    wrappers = wrappers or {}
     venv = VecMonitor(sb3_vec_env(n_envs, seed=seed, **env_kwargs))
+    if wrappers.get("residual"):
+        venv = residual_vec_env(venv, base, wrappers["residual"]["scale"])
     if normalize is not None:
-        venv = VecNormalize(venv, **normalize)
+        if stats is not None and Path(stats).is_file():
+            venv = VecNormalize.load(str(stats), venv)
+        else:
+            venv = VecNormalize(venv, **normalize)
+    if wrappers.get("frame_stack", 1) > 1:
+        venv = VecFrameStack(venv, wrappers["frame_stack"])
     return venv
+
+
+def run_policy(model, wrappers: dict, base=None) -> SB3Policy:
+    """The model as a policy object with the same observation pipeline as in training."""
+    res = wrappers.get("residual")
+    return SB3Policy(model, find_vecnormalize(model.get_env()),
+                     frame_stack=wrappers.get("frame_stack", 1),
+                     residual=(base, res["scale"]) if res else None)
 
 
 def _count(name: str, value) -> int:
@@ -148,13 +236,19 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     if threads:
         torch.set_num_threads(threads)
     set_random_seed(seed)
-    venv = make_training_env(n_envs, seed, env_kwargs, normalize_kwargs(hp))
+    wrappers = wrapper_spec(project, env_kwargs)
+    base = residual_base(wrappers, env_kwargs)
+    if resume and not Path(resume).is_file():
+        raise TrainingError(f"checkpoint to resume not found: {resume}")
+    venv = make_training_env(n_envs, seed, env_kwargs, normalize_kwargs(hp), wrappers, base,
+                             stats=vecnormalize_path(Path(resume)) if resume else None)
     _write_run_files(run, algo, task_id, {task_id: hp, PROJECT_BLOCK: project}, venv, seed,
                      n_envs, timesteps)
     model = _model(algo, hp, venv, seed, run, resume)
     freq = int(eval_freq or project.get("eval_freq", 50_000))
     suite_cb = suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1),
-                                   run, env_kwargs.get("params"), on_eval)
+                                   run, env_kwargs.get("params"), on_eval, wrappers, base)
+    write_wrappers(run / "checkpoints" / FOLDER_WRAPPERS, wrappers)
     callbacks = [CheckpointCallback(max(freq // n_envs, 1), str(run / "checkpoints"),
                                     name_prefix=algo, save_vecnormalize=True), suite_cb]
     if progress_bar:
@@ -163,9 +257,9 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     model.learn(total_timesteps=timesteps, callback=CallbackList(callbacks),
                 reset_num_timesteps=resume is None, tb_log_name=algo)
     wall = time.perf_counter() - t0
-    save_model(model, run / f"{algo}_final.zip")
+    save_model(model, run / f"{algo}_final.zip", wrappers)
     summary = {"algo": algo, "task": task_id, "timesteps": timesteps, "n_envs": n_envs,
-               "seed": seed,
+               "seed": seed, "wrappers": clean_wrappers(wrappers),
                "wall_time_s": wall, "steps_per_s": timesteps / wall,
                "machine": platform.processor() or platform.machine(),
                "threads": torch.get_num_threads()}
@@ -177,9 +271,11 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     return run
 
 
-def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=None):
+def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=None,
+                        wrappers: dict | None = None, base=None):
     """A callback that, every ``freq`` calls, scores the current policy on the fixed suite
-    (deterministic actions, the training VecNormalize statistics), logs it, appends it to
+    (deterministic actions, the training VecNormalize statistics, the frame stack and residual
+    base of ``wrappers``), logs it, appends it to
     ``evaluations.json`` and saves the best-scoring model (with its statistics) as
     ``best_model.zip``; it scores once more at the end of training."""
     from stable_baselines3.common.callbacks import BaseCallback
@@ -201,7 +297,7 @@ def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=N
                 self.evaluate_now()
 
         def evaluate_now(self) -> None:
-            score = suite_score(SB3Policy(self.model, self.model.get_env()), suite,
+            score = suite_score(run_policy(self.model, wrappers or {}, base), suite,
                                 params=params)
             self.logger.record("eval/suite_score", score)
             self.history.append({"timesteps": int(self.num_timesteps), "score": score,
@@ -210,7 +306,7 @@ def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=N
             best = score > self.best
             if best:
                 self.best = score
-                save_model(self.model, Path(run) / "best_model.zip")
+                save_model(self.model, Path(run) / "best_model.zip", wrappers)
             if on_eval is not None:
                 on_eval({**self.history[-1], "best": best}, Path(run))
 
@@ -276,25 +372,10 @@ def _model(algo, hp, venv, seed, run, resume):
 
         kwargs["action_noise"] = NormalActionNoise(np.zeros(1), hp.get("noise_std", 0.1) *
                                                    np.ones(1))
-    if resume:
-        resume = Path(resume)
-        if not resume.is_file():
-            raise TrainingError(f"checkpoint to resume not found: {resume}")
-        model = Algo.load(resume, env=_load_vecnormalize_into(resume, venv), seed=seed,
-                          tensorboard_log=tb)
-        return model
-    return Algo(hp.get("policy", "MlpPolicy"), venv, seed=seed, verbose=0, tensorboard_log=tb,
-                **kwargs)
-
-
-def _load_vecnormalize_into(checkpoint: Path, venv):
-    """Restore the VecNormalize statistics saved beside a checkpoint (if both exist)."""
-    from stable_baselines3.common.vec_env import VecNormalize
-
-    stats = vecnormalize_path(checkpoint)
-    if isinstance(venv, VecNormalize) and stats.is_file():
-        return VecNormalize.load(str(stats), venv.venv)
-    return venv
+    if resume:  # the VecNormalize statistics saved beside it are already in venv
+        return Algo.load(Path(resume), env=venv, seed=seed, tensorboard_log=tb)
+    policy = hp.get("policy", "MlpLstmPolicy" if algo == "rppo" else "MlpPolicy")
+    return Algo(policy, venv, seed=seed, verbose=0, tensorboard_log=tb, **kwargs)
 
 
 def _write_run_files(run, algo, task_id, blocks, venv, seed, n_envs, timesteps):
