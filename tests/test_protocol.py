@@ -233,7 +233,8 @@ def test_condensed_view_marks_the_paired_verdicts():
     """protocol_summary on a constructed two-policy cell: the mean and interval as printed, a
     policy uniformly better than passive on RMS x marked with the up-triangle, and the aggregate
     row present."""
-    from aerostat_gym.agents.protocol_summary import aggregate_table, metric_table
+    from aerostat_gym.agents.protocol import aggregate_markdown
+    from aerostat_gym.agents.protocol_summary import metric_table
 
     entry = {"mean": 5.0, "ci": [4.0, 6.0]}
     cell = {"scenario": "gusty", "wind_speed": 8.0,
@@ -247,5 +248,5 @@ def test_condensed_view_marks_the_paired_verdicts():
                                    "p_improvement": {"passive": {"p": 0.8, "ci": [0.7, 0.9]}}}}}
     table = metric_table(proto, [("gusty", "rms_x_m", 1.0, 1, (8.0,))])
     assert table.splitlines()[2] == "| `gusty` | 8 | 7.0 | 5.0 [4.0, 6.0] ▲ |"
-    agg = aggregate_table(proto).splitlines()
+    agg = aggregate_markdown(proto).splitlines()
     assert agg[3] == "| lqr | -0.500 [-0.600, -0.400] | 0.80 [0.70, 0.90] | - |"

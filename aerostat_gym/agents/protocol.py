@@ -256,14 +256,14 @@ def _num(v: float, scale: float, digits: int) -> str:
     return "n/a" if v is None or not math.isfinite(v) else f"{v * scale:.{digits}f}"
 
 
-def _cell_text(entry, scale: float, digits: int) -> str:
+def interval_text(entry, scale: float, digits: int) -> str:
+    """``mean [low, high]`` of a metric entry, scaled; the interval is left out where it rounds
+    to one point at the printed digits (every seed gave the same episode)."""
     if entry is None:
         return "n/a"
-    lo, hi = entry["ci"]
-    if lo == hi:
-        return _num(entry["mean"], scale, digits)
-    return (f"{_num(entry['mean'], scale, digits)} "
-            f"[{_num(lo, scale, digits)}, {_num(hi, scale, digits)}]")
+    lo, hi = (_num(v, scale, digits) for v in entry["ci"])
+    mean = _num(entry["mean"], scale, digits)
+    return mean if lo == hi else f"{mean} [{lo}, {hi}]"
 
 
 def _verdict_text(paired: dict) -> str:
@@ -282,7 +282,7 @@ def cell_markdown(cell: dict, reference: str = "passive") -> str:
     head = ["policy", *(SHOW[m][0] for m in shown), f"vs {reference} (paired 95 % CI)"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for lab, means in cell["policies"].items():
-        row = [lab] + [_cell_text(means.get(m), *SHOW[m][1:]) for m in shown]
+        row = [lab] + [interval_text(means.get(m), *SHOW[m][1:]) for m in shown]
         paired = cell["paired"].get(lab, {}).get(reference)
         row.append("(reference)" if lab == reference else
                    "n/a" if paired is None else _verdict_text(paired))
@@ -290,17 +290,17 @@ def cell_markdown(cell: dict, reference: str = "passive") -> str:
     return "\n".join(lines)
 
 
-def aggregate_markdown(proto: dict) -> str:
+def aggregate_markdown(proto: dict, label=str) -> str:
     """Markdown table: IQM [95 % CI] of the normalised score and P(improvement) [95 % CI] over
-    each other policy."""
+    each other policy; ``label(name)`` names the policies."""
     agg = proto["aggregate"]
     labels = list(agg)
-    head = ["policy", "IQM score [95 % CI]", *(f"P(better than {o})" for o in labels)]
+    head = ["policy", "IQM score [95 % CI]", *(f"P(better than {label(o)})" for o in labels)]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for lab in labels:
         row = agg[lab]
         lo, hi = row["iqm_ci"]
-        cells = [lab, f"{row['iqm']:.3f} [{_num(lo, 1, 3)}, {_num(hi, 1, 3)}]"]
+        cells = [label(lab), f"{row['iqm']:.3f} [{_num(lo, 1, 3)}, {_num(hi, 1, 3)}]"]
         for o in labels:
             p = row["p_improvement"].get(o)
             cells.append("-" if p is None else

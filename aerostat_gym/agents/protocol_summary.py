@@ -6,6 +6,8 @@ a mark for the paired verdict against the reference policy (the full per-cell ta
 
 from __future__ import annotations
 
+from .protocol import aggregate_markdown, interval_text
+
 #: Mark of a paired verdict against the reference policy (no mark: indistinguishable).
 MARKS = {"better": " ▲", "worse": " ▼", "indistinguishable": "", "n/a": " ?"}
 RECOVER_SPEEDS = (5.0, 10.0, 15.0)
@@ -35,11 +37,7 @@ def label(policy: str) -> str:
 def cell_text(cell: dict, policy: str, metric: str, scale: float, digits: int,
               reference: str = "passive") -> str:
     """``mean [low, high]`` (no interval where it rounds to a point) and the verdict mark."""
-    entry = cell["policies"][policy][metric]
-    lo, hi = (v * scale for v in entry["ci"])
-    text = f"{entry['mean'] * scale:.{digits}f}"
-    if round(lo, digits) != round(hi, digits):
-        text += f" [{lo:.{digits}f}, {hi:.{digits}f}]"
+    text = interval_text(cell["policies"][policy][metric], scale, digits)
     if policy != reference:
         text += MARKS[cell["paired"][policy][reference][metric]["verdict"]]
     return text
@@ -58,27 +56,6 @@ def metric_table(proto: dict, rows, reference: str = "passive") -> str:
     return "\n".join(lines)
 
 
-def aggregate_table(proto: dict) -> str:
-    """IQM score with its interval and the probability that the row policy beats each column
-    policy."""
-    agg = proto["aggregate"]
-    policies = list(agg)
-    lines = ["| policy | IQM score [95 % CI] | " +
-             " | ".join(f"P(> {label(q)})" for q in policies) + " |",
-             "|---|---|" + "---|" * len(policies)]
-    for p in policies:
-        a = agg[p]
-        row = [f"{a['iqm']:.3f} [{a['iqm_ci'][0]:.3f}, {a['iqm_ci'][1]:.3f}]"]
-        for q in policies:
-            if q == p:
-                row.append("-")
-            else:
-                pi = a["p_improvement"][q]
-                row.append(f"{pi['p']:.2f} [{pi['ci'][0]:.2f}, {pi['ci'][1]:.2f}]")
-        lines.append(f"| {label(p)} | " + " | ".join(row) + " |")
-    return "\n".join(lines)
-
-
 def condensed(proto: dict, reference: str = "passive") -> str:
     """Every table of :data:`VIEW` that has rows in ``proto``, then the aggregate."""
     parts = []
@@ -86,5 +63,5 @@ def condensed(proto: dict, reference: str = "passive") -> str:
         table = metric_table(proto, rows, reference)
         if table.count("\n") > 1:
             parts.append(f"{heading}:\n\n{table}")
-    parts.append(f"Aggregate:\n\n{aggregate_table(proto)}")
+    parts.append(f"Aggregate:\n\n{aggregate_markdown(proto, label)}")
     return "\n\n".join(parts) + "\n"

@@ -177,6 +177,13 @@ class TetheredAerostatEnv(gym.Env):
       configuration (430 m high for the baseline, was 340 m); an optional Froude-Krylov plus
       added-mass force of accelerating air on the hull (``aerostat.air_inertia``, off by
       default). Steady-wind trims are unchanged.
+    - v0 (aerostat-gym 0.3; reward and winch logic changed, id kept): the default reward is the
+      winch-control score (displacement weight 1.0, was 0.2; the length term free within 5 % of
+      the tether length, was quadratic from zero), so returns are not comparable with 0.2's; the
+      winch brakes on an exact-zero command or after ``winch.brake_dwell`` = 10 s inside
+      ``winch.brake_speed`` = 0.002 m/s (was: at once below 0.02 m/s), so small commands reach
+      the drum; the stand-still clock is part of ``get_state``. Trims and the braked dynamics
+      are unchanged.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
