@@ -18,7 +18,12 @@ TASKS: dict[str, tuple[dict, str]] = {
     "TetheredAerostatDamping-v0": (
         {"turbulence": "none", "perturbation": "displacement"},
         "calm-air damping: 3-15 m/s steady wind, an initial swing of up to 10 m along and 5 m "
-        "across the wind and a pitch kick of up to 0.05 rad (the shipped PPO policy's task)"),
+        "across the wind and a pitch kick of up to 0.05 rad"),
+    "TetheredAerostatDampingNoisy-v0": (
+        {"turbulence": "none", "perturbation": "displacement", "obs_noise": 0.01},
+        "the damping task on noisy sensors: as TetheredAerostatDamping-v0, with Gaussian noise "
+        "of 0.01 (scaled units) on every standard channel, the evaluation protocol's level "
+        "(the shipped PPO policy's task)"),
 }
 
 

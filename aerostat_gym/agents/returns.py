@@ -29,7 +29,8 @@ def task_returns(policy_name: str, task_id: str, seeds=RETURN_SEEDS, params=None
     kwargs = dict(TASKS[task_id][0])
     if params is not None:
         kwargs["params"] = params
-    policy = load_policy(policy_name, params=params)
+    # a filtering baseline (the LQG) is designed for the task's sensor noise
+    policy = load_policy(policy_name, params=params, obs_noise=kwargs.get("obs_noise", 0.0))
     env = TetheredAerostatVectorEnv(num_envs=len(seeds), observation="full", **kwargs)
     obs, _ = env.reset(seed=seeds)
     total, _ = rollout(policy, env, obs, MAX_EPISODE_STEPS)

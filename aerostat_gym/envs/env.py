@@ -183,7 +183,8 @@ class TetheredAerostatEnv(gym.Env):
       winch brakes on an exact-zero command or after ``winch.brake_dwell`` = 10 s inside
       ``winch.brake_speed`` = 0.002 m/s (was: at once below 0.02 m/s), so small commands reach
       the drum; the stand-still clock is part of ``get_state``. Trims and the braked dynamics
-      are unchanged.
+      are unchanged. New task id ``TetheredAerostatDampingNoisy-v0`` (the damping task with the
+      evaluation protocol's sensor noise, 0.01), the shipped policy's task.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
