@@ -39,6 +39,7 @@ from aerostat_gym.agents.lqg import LQGPolicy, LQGSchedule
 from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule
 from aerostat_gym.agents.modal import ModalPolicy, ModalSchedule
 from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy, load_policy
+from aerostat_gym.agents.protocol import json_safe
 from aerostat_gym.params import load_params
 
 SPEEDS = (5.0, 10.0, 15.0)
@@ -131,17 +132,6 @@ def _label(name: str) -> str:
     return Path(name).stem if name.endswith(".zip") else name
 
 
-def _clean(value):
-    """JSON-safe: NaN -> None, recursively."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_clean(v) for v in value]
-    return value
-
-
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--swing", type=float, default=10.0, help="initial along-wind swing [m]")
@@ -167,7 +157,7 @@ def main(argv=None) -> dict:
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
         with open(args.json, "w") as fh:
-            json.dump(_clean(out), fh, indent=1)
+            json.dump(json_safe(out), fh, indent=1)
     if args.plot:
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
         plot(rows, limits, args.plot, max_speed=float(params.winch.max_speed), swing=args.swing)

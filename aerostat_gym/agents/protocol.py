@@ -329,14 +329,18 @@ def protocol_markdown(proto: dict, reference: str = "passive") -> str:
     return "\n".join(parts)
 
 
+def json_safe(value):
+    """``value`` with every non-finite float replaced by None, through dicts, lists and tuples
+    (JSON has no NaN)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: json_safe(x) for k, x in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_safe(x) for x in value]
+    return value
+
+
 def dumps(proto: dict) -> str:
     """JSON text of :func:`protocol`'s output (NaN written as null)."""
-    def clean(v):
-        if isinstance(v, float) and not math.isfinite(v):
-            return None
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, list):
-            return [clean(x) for x in v]
-        return v
-    return json.dumps(clean(proto), indent=1)
+    return json.dumps(json_safe(proto), indent=1)
