@@ -2,7 +2,7 @@
 
 from .registration import ENV_ID, register
 
-__version__ = "0.3.0"
+__version__ = "0.4.0"
 
 register()
 

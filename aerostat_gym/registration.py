@@ -23,7 +23,13 @@ TASKS: dict[str, tuple[dict, str]] = {
         {"turbulence": "none", "perturbation": "displacement", "obs_noise": 0.01},
         "the damping task on noisy sensors: as TetheredAerostatDamping-v0, with Gaussian noise "
         "of 0.01 (scaled units) on every standard channel, the evaluation protocol's level "
-        "(the shipped PPO policy's task)"),
+        "(the PPO policy shipped with 0.3.0)"),
+    "TetheredAerostatRealistic-v0": (
+        {"turbulence": "light", "perturbation": "displacement", "randomize": True,
+         "obs_noise": 0.01},
+        "winch control in realistic conditions: 3-15 m/s, light turbulence (5 % intensity), an "
+        "initial swing as in the damping task, the estimated parameters randomised per episode "
+        "and the evaluation protocol's sensor noise (the shipped policy's task)"),
 }
 
 

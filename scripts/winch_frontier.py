@@ -1,6 +1,6 @@
 """Frontier of the winch policies: pendulum damping ratio against peak reel speed at 5, 10 and
-15 m/s for the passive (braked) winch, tension feedback, the LQR, the LQG, the modal
-controller's curve and the learned policies, measured in the environment (swing recovery,
+15 m/s for the passive (braked) winch, tension feedback, the LQR, the LQG, the modal gains on
+the LQG's filter (modal_lqg), the modal controller's curve and the learned policies, measured in the environment (swing recovery,
 steady wind, the shipped winch and its brake logic), with the modal line's linear end at the
 winch's speed limit.
 
@@ -9,11 +9,12 @@ Usage::
     PYTHONPATH=. python scripts/winch_frontier.py [--swing 10] [--policy shipped ...]
         [--json docs/figures/frontier.json] [--plot docs/figures/frontier.png]
 
-Every run uses the full-state environment without sensor noise except the LQG, which reads the
-standard observation with sensor noise LQG_NOISE (scaled units, seed LQG_SEED), the noise its
-filter is designed for. Learned policies (``--policy``, repeatable: a name for
+Every run uses the full-state environment without sensor noise except the two filtering
+baselines (LQG, modal_lqg) and the learned policies (``--policy``, repeatable: a name for
 :func:`aerostat_gym.agents.policies.load_policy` or a path to an SB3 .zip; default the shipped
-PPO) run deterministically on the noise-free observation they were trained for.
+policy), which read the standard observation with sensor noise LQG_NOISE (scaled units, seed
+LQG_SEED): the noise the filters are designed for and the shipped policy was trained with. The
+learned policies act deterministically.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from aerostat_gym.agents.frontier import (
     frontier_table,
     initial_deviation,
     linear_fit_zeta,
+    modal_fractions,
     modal_peak_limit,
     plot_frontier,
     saturated_speeds,
@@ -46,9 +48,10 @@ SPEEDS = (5.0, 10.0, 15.0)
 #: Target pendulum damping ratios of the modal controller's curve per wind speed.
 MODAL_ZETAS = {5.0: (0.16, 0.18, 0.20, 0.22, 0.25), 10.0: (0.35, 0.45, 0.55, 0.60, 0.70),
                15.0: (0.45, 0.60, 0.75, 0.85, 0.95)}
-#: Sensor noise (scaled units) of the LQG's runs and of its filter design.
+#: Sensor noise (scaled units) of the filtering baselines' and the learned policies' runs and
+#: of the filters' design.
 LQG_NOISE = 0.01
-#: Reset seed of the LQG's runs (draws the sensor noise).
+#: Reset seed of the noisy runs (draws the sensor noise).
 LQG_SEED = 3
 #: Learned policies run by default.
 DEFAULT_POLICIES = ("shipped",)
@@ -65,7 +68,7 @@ def _row(policy, kind, designed, run, linear_fit=_NAN) -> dict:
 
 
 def baselines_at(params, U, swing) -> list[dict]:
-    """Passive, tension-feedback, LQR and LQG rows at one wind speed."""
+    """Passive, tension-feedback, LQR, LQG and modal_lqg rows at one wind speed."""
     lqr = LQRSchedule(params, speeds=np.array([U]))
     d = lqr.designs[0]
     designed = float(d.mode("pendulum").zeta)
@@ -74,6 +77,8 @@ def baselines_at(params, U, swing) -> list[dict]:
     braked = float(d.mode("pendulum", "braked").zeta)
     lqg = LQGPolicy(params, schedule=LQGSchedule(params, speeds=np.array([U]),
                                                  obs_noise=LQG_NOISE))
+    modal_lqg = LQGPolicy(params, schedule=LQGSchedule(params, speeds=np.array([U]),
+                                                       obs_noise=LQG_NOISE, gains="modal"))
     return [
         _row("passive", "passive", braked, swing_response(PassivePolicy(), U, swing)),
         _row("tension", "baseline", None,
@@ -82,6 +87,8 @@ def baselines_at(params, U, swing) -> list[dict]:
              swing_response(LQRPolicy(params, schedule=lqr), U, swing), lin),
         _row("lqg", "baseline", designed,
              swing_response(lqg, U, swing, obs_noise=LQG_NOISE, seed=LQG_SEED), lin),
+        _row("modal_lqg", "baseline", modal_lqg.schedule.designs[0].modes["pendulum"]["closed"]
+             ["zeta"], swing_response(modal_lqg, U, swing, obs_noise=LQG_NOISE, seed=LQG_SEED)),
     ]
 
 
@@ -101,7 +108,8 @@ def modal_curve_at(params, U, swing, zetas) -> list[dict]:
 
 def learned_at(policies: dict, U, swing) -> list[dict]:
     """One row per learned policy (label -> policy) at one wind speed."""
-    return [_row(label, "learned", None, swing_response(pol, U, swing))
+    return [_row(label, "learned", None,
+                 swing_response(pol, U, swing, obs_noise=LQG_NOISE, seed=LQG_SEED))
             for label, pol in policies.items()]
 
 
@@ -152,8 +160,16 @@ def main(argv=None) -> dict:
     print(table(rows))
     print()
     print(limits_text(limits))
+    fractions = modal_fractions(rows)
+    print("\nDamping over the modal curve's at the same peak reel speed (single-mode fit):")
+    for f in fractions:
+        print(f"  {f['wind_speed']:g} m/s {f['policy']}: {f['zeta']:.3f} / "
+              f"{f['modal_at_same_peak']:.3f} = {f['fraction']:.2f} at "
+              f"{f['peak_reel_speed_m_s']:.3f} m/s" + ("" if f["within_curve"] else
+                                                        " (outside the curve's range)"))
     out = {"swing_m": args.swing, "lqg_noise": LQG_NOISE, "lqg_seed": LQG_SEED,
-           "max_speed_m_s": float(params.winch.max_speed), "rows": rows, "limits": limits}
+           "max_speed_m_s": float(params.winch.max_speed), "rows": rows, "limits": limits,
+           "modal_fractions": fractions}
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
         with open(args.json, "w") as fh:

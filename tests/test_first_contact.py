@@ -67,14 +67,15 @@ def test_shipped_policy_trained_on_its_registered_task():
     task, and its version record is this package's version (so gym.make(task_id) is the
     training environment, reward and winch logic included)."""
     task_id, hp, project = load_hyperparams("ppo")
-    assert task_id == "TetheredAerostatDampingNoisy-v0"
+    assert task_id == "TetheredAerostatRealistic-v0"
     run = ROOT / "agents" / "ppo_training"
     recorded = yaml.safe_load((run / "hyperparams.yml").read_text())
     assert set(recorded) == {task_id, "aerostat_gym"}
     assert recorded[task_id] == hp and recorded["aerostat_gym"] == project
     assert json.loads((run / "training_summary.json").read_text())["task"] == task_id
     assert json.loads((run / "version.json").read_text())["aerostat_gym"] == aerostat_gym.__version__
-    assert project == {"eval_freq": 100000, "eval_suite": "damping"}
+    assert project == {"eval_freq": 200000, "eval_suite": "damping",
+                       "residual": {"base": "modal_lqg", "scale": 0.1}}
 
 
 @pytest.mark.parametrize("value, expect", [
@@ -95,13 +96,13 @@ def test_rl_zoo3_trains_on_the_shipped_yaml(tmp_path):
     pytest.importorskip("rl_zoo3")
     conf = shipped_path("hyperparams", "ppo.yml")
     cmd = [sys.executable, "-m", "rl_zoo3.train", "--algo", "ppo",
-           "--env", "TetheredAerostatDampingNoisy-v0", "--gym-packages", "aerostat_gym",
+           "--env", "TetheredAerostatRealistic-v0", "--gym-packages", "aerostat_gym",
            "--conf-file", str(conf), "-n", "2048", "--eval-freq", "-1", "--seed", "0",
            "--log-folder", str(tmp_path), "--vec-env", "dummy", "--device", "cpu",
            "--hyperparams", "n_envs:2", "n_steps:512", "batch_size:256", "n_epochs:1"]
     out = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=900)
     assert out.returncode == 0, out.stderr[-2000:]
-    saved = list(tmp_path.rglob("TetheredAerostatDampingNoisy-v0.zip"))
+    saved = list(tmp_path.rglob("TetheredAerostatRealistic-v0.zip"))
     assert saved, out.stdout[-2000:]
     from stable_baselines3 import PPO
 
@@ -120,7 +121,7 @@ def test_commands_work_from_any_directory(tmp_path):
                   "--eval-freq", "1000000000", "--no-progress", "--threads", "1"], tmp_path)
     assert train.returncode == 0, train.stderr[-2000:]
     summary = json.loads((tmp_path / "run" / "training_summary.json").read_text())
-    assert summary["task"] == "TetheredAerostatDampingNoisy-v0" and summary["timesteps"] == 2000
+    assert summary["task"] == "TetheredAerostatRealistic-v0" and summary["timesteps"] == 2000
     command = (tmp_path / "run" / "command.txt").read_text()
     assert command.startswith("aerostat-gym train") and str(tmp_path) not in command
     ev = _cli(["evaluate", "--policy", "passive", "--policy", "run/ppo_final.zip",

@@ -37,6 +37,8 @@ VARIANTS = {
                       "policy_kwargs": {"lstm_hidden_size": 16, "net_arch": [16]}}, {}, 512),
     "residual-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
                      {"residual": {"base": "lqg", "scale": 0.3}}, 1024),
+    "residual-modal-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
+                           {"residual": {"base": "modal_lqg", "scale": 0.1}}, 1024),
     "stack-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
                   {"frame_stack": 4}, 1024),
 }

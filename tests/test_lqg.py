@@ -143,3 +143,42 @@ def test_nonlinear_damping_with_sensor_noise(params, schedule):
     pred = schedule.designs[0].lqr.mode("pendulum").zeta
     assert run.ended is None and run.r2 > 0.99
     assert run.zeta == pytest.approx(pred, rel=0.20)
+
+
+@pytest.fixture(scope="module")
+def modal_schedule(params):
+    return LQGSchedule(params, speeds=np.array([10.0, 15.0]), dt=DT, obs_noise=NOISE,
+                       gains="modal")
+
+
+def test_modal_gains_are_the_modal_design(params, modal_schedule):
+    """gains="modal": the state gain on the estimate is the modal design's over the same subset
+    (to 1e-12 relative), with no length integral, and the state-feedback poles of the subset
+    are the modal design's expected ones (pendulum placed at the designed ratio, every other
+    mode where it was) within the modal design's own placement tolerance (1e-6)."""
+    from aerostat_gym.agents.modal import PLACEMENT_TOL, design_modal, pole_set_distance
+
+    for d in modal_schedule.designs:
+        m = design_modal(params, d.wind_speed, dt=DT)
+        assert np.allclose(d.K, m.K[d.index], rtol=1e-12, atol=1e-12 * np.abs(m.K).max())
+        assert d.K_integral == 0.0
+        poles = np.linalg.eigvals(d.Ad - d.Bd @ d.K[None, :])
+        assert pole_set_distance(poles, m.expected_poles()) < PLACEMENT_TOL
+        assert d.summary()["pendulum"]["closed"]["zeta"] == pytest.approx(m.zeta, abs=1e-12)
+    with pytest.raises(ValueError, match="gains"):
+        design_lqg(params, 10.0, gains="pid")
+
+
+@pytest.mark.parametrize("wind_speed", [10.0, 15.0])
+def test_modal_lqg_damping_with_sensor_noise(params, modal_schedule, wind_speed):
+    """Environment, 10 m swing, obs_noise = 0.01, brake logic on: the modal gains on the
+    Kalman estimate keep the privileged modal controller's damping. Measured (seed 3): single-
+    mode fit 0.547 at 10 m/s and 0.755 at 15 m/s against the designed 0.60 and 0.85 (the fit
+    reads the privileged modal controller 0.545 and 0.755, see tests/test_modal.py); asserted
+    within 20 % of the designed ratio, like the modal controller's own test."""
+    pol = LQGPolicy(params, dt=DT, schedule=modal_schedule)
+    run = swing_response(pol, wind_speed, 10.0, obs_noise=NOISE, seed=3)
+    designed = {10.0: 0.60, 15.0: 0.85}[wind_speed]
+    assert run.ended is None and run.r2 > 0.99
+    assert run.zeta == pytest.approx(designed, rel=0.20)
+    assert np.max(np.abs(run.set_point)) <= params.winch.max_speed

@@ -250,3 +250,34 @@ def test_condensed_view_marks_the_paired_verdicts():
     assert table.splitlines()[2] == "| `gusty` | 8 | 7.0 | 5.0 [4.0, 6.0] ▲ |"
     agg = aggregate_markdown(proto).splitlines()
     assert agg[3] == "| lqr | -0.500 [-0.600, -0.400] | 0.80 [0.70, 0.90] | - |"
+
+
+def test_pooled_training_seeds_keep_seed_blocks():
+    """Three training seeds of one configuration, returns -50 (seed 0), -60, -70 on every
+    episode, against passive at -100: pooled, the configuration has 3 x 4 runs per cell in
+    training-seed blocks; its IQM is the middle half of (-50 x 4, -60 x 4, -70 x 4), -60 / 100
+    (exact), it beats passive in every pair (P = 1), and the per-seed table of
+    :func:`seed_spread` gives each seed's own IQM (-0.5, -0.6, -0.7)."""
+    from aerostat_gym.agents.protocol import aggregate, pool_training_seeds
+    from aerostat_gym.agents.seed_spread import seed_spread, seed_spread_markdown
+
+    seeds = (1, 2, 3, 4)
+    passive = _result("passive", "gusty", [_episode(s) for s in seeds])
+    runs = [_result(f"s{g}", "gusty", [_episode(s, **{"return": -50.0 - 10 * g}) for s in seeds])
+            for g in range(3)]
+    pooled = pool_training_seeds(runs, "cfg")
+    assert pooled["groups"] == 3 and pooled["members"] == ["s0", "s1", "s2"]
+    rets = [e["return"] for e in pooled["scenarios"]["gusty"]["episodes"]]
+    assert rets == [-50.0] * 4 + [-60.0] * 4 + [-70.0] * 4
+    agg = aggregate([passive, pooled])["aggregate"]
+    assert agg["cfg"]["iqm"] == pytest.approx(-0.6, abs=1e-12)
+    assert agg["cfg"]["training_seeds"] == 3
+    assert agg["cfg"]["p_improvement"]["passive"] == {"p": 1.0, "ci": [1.0, 1.0]}
+    lo, hi = agg["cfg"]["iqm_ci"]
+    assert -0.7 - 1e-12 <= lo < -0.6 < hi <= -0.5 + 1e-12  # the seed blocks spread it
+    spread = seed_spread([passive], runs, "cfg")
+    assert [r["iqm"] for r in spread["per_seed"]] == pytest.approx([-0.5, -0.6, -0.7])
+    assert spread["iqm_over_seeds"]["median"] == pytest.approx(-0.6)
+    assert "min -0.700, median -0.600, max -0.500" in seed_spread_markdown(spread)
+    with pytest.raises(ValueError, match="distinct"):
+        pool_training_seeds([runs[0], runs[0]], "cfg")

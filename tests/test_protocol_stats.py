@@ -136,6 +136,32 @@ def test_probability_of_improvement_ci_separated():
     assert (ci.estimate, ci.low, ci.high) == (1.0, 1.0, 1.0)
 
 
+def test_hierarchical_bootstrap_carries_the_spread_between_training_seeds():
+    """8 training seeds whose means scatter N(0, 1), 10 episodes each scattering 0.1 about
+    their seed's mean: the population IQM is 0 (a symmetric mixture). Over 300 synthetic
+    experiments (1000 resamples each) the 95 % interval that resamples training seeds, then
+    episodes (groups=8), covers 0 in 90.0 % of them (asserted at least 85 %: 8 seeds give a
+    percentile interval a little under nominal); the one that treats the 80 episodes as
+    independent runs covers it in 47.7 % (asserted at most 60 %)."""
+    rng = np.random.default_rng(1)
+    covered = {1: 0, 8: 0}
+    for k in range(300):
+        means = rng.normal(size=8)
+        s = (means[:, None] + 0.1 * rng.normal(size=(8, 10))).reshape(80, 1)
+        for g in covered:
+            ci = iqm_ci(s, resamples=1000, seed=k, groups=g)
+            covered[g] += ci.low <= 0.0 <= ci.high
+    assert covered[8] / 300 >= 0.85
+    assert covered[1] / 300 <= 0.60
+    x = np.full((10, 2), 2.0) + np.arange(10)[:, None] * 0.01
+    ci = probability_of_improvement_ci(x, np.zeros((10, 2)), resamples=300, groups_x=5)
+    assert (ci.estimate, ci.low, ci.high) == (1.0, 1.0, 1.0)
+    with pytest.raises(StatsInputError, match="equal groups"):
+        iqm_ci(np.zeros((10, 2)), groups=3)
+    with pytest.raises(StatsInputError, match="equal groups"):
+        iqm_ci(np.zeros((10, 2)), groups=10)
+
+
 def test_bad_input_named():
     """A NaN entry, a length mismatch, a bad level or method: errors that name the problem."""
     with pytest.raises(StatsInputError, match="entry 2"):

@@ -283,7 +283,8 @@ def modal_peak_limit(params, wind_speed: float, swing: float, peak: float = 1.0,
 BASELINE_MARKERS = {"passive": ("s", "black", "passive (braked winch)"),
                     "tension": ("^", "tab:green", "tension feedback"),
                     "lqr": ("D", "tab:red", "LQR (full state)"),
-                    "lqg": ("v", "tab:purple", "LQG (sensor noise)")}
+                    "lqg": ("v", "tab:purple", "LQG (sensor noise)"),
+                    "modal_lqg": ("h", "tab:brown", "modal on a Kalman filter (sensor noise)")}
 #: Colours the learned policies take in turn.
 LEARNED_COLOURS = ("gold", "tab:orange", "tab:pink", "tab:cyan", "tab:olive")
 #: Legend names of learned policies known by name (others: their name).
@@ -315,6 +316,31 @@ def frontier_table(rows: list[dict]) -> str:
                      f"{r['peak_reel_speed_m_s']:.3f} | {r['peak_set_point_m_s']:.3f} | "
                      f"{r['length_wander_m']:.2f} |")
     return "\n".join(lines)
+
+
+def modal_fractions(rows: list[dict], fit: str = "zeta") -> list[dict]:
+    """Each non-modal run's damping as a fraction of the modal controller's curve at the same
+    peak reel speed: the modal runs at one wind speed, sorted by peak reel speed, are
+    interpolated linearly in (peak reel speed, ``fit``) (held at the ends); a fraction of 0.9
+    at a peak reel speed within the curve's range is "90 % of the modal controller's damping at
+    equal peak reel speed". ``fit``: "zeta" (single-mode fit) or "zeta_drift"."""
+    out = []
+    for U in sorted({float(r["wind_speed"]) for r in rows}):
+        curve = sorted((r["peak_reel_speed_m_s"], r[fit]) for r in rows
+                       if r.get("kind") == "modal" and float(r["wind_speed"]) == U
+                       and math.isfinite(r[fit]))
+        if not curve:
+            continue
+        v, z = np.array(curve).T
+        for r in rows:
+            if r.get("kind") == "modal" or float(r["wind_speed"]) != U:
+                continue
+            ref = float(np.interp(r["peak_reel_speed_m_s"], v, z))
+            out.append({"wind_speed": U, "policy": r["policy"],
+                        "peak_reel_speed_m_s": r["peak_reel_speed_m_s"], fit: r[fit],
+                        "modal_at_same_peak": ref, "fraction": r[fit] / ref,
+                        "within_curve": bool(v[0] <= r["peak_reel_speed_m_s"] <= v[-1])})
+    return out
 
 
 def saturates(row: dict, max_speed: float = 1.0) -> bool:

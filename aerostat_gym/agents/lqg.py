@@ -1,12 +1,16 @@
-"""Output-feedback LQG winch controller: a steady-state Kalman filter on the standard observation
-channels (the ones a learned policy sees, with the environment's sensor noise) and the
-gain-scheduled LQR gains acting on the estimate.
+"""Output-feedback winch controllers: a steady-state Kalman filter on the standard observation
+channels (the ones a learned policy sees, with the environment's sensor noise) and a
+gain-scheduled state feedback acting on the estimate: the LQR's gains (``gains="lqr"``, the
+``lqg`` baseline) or the modal pole placement's (``gains="modal"``, the ``modal_lqg`` baseline:
+the frontier controller on equal information with a learned policy).
 
 Design at one mean wind speed U (:func:`design_lqg`):
 
-1. the LQR of :func:`aerostat_gym.agents.lqr.design_lqr` on the longitudinal + winch subset
-   (``subset="long"``: the lateral states are uncontrollable from the winch and get no gain), with
-   its integral of the length error;
+1. the state feedback on the longitudinal + winch subset (the lateral states are uncontrollable
+   from the winch and get no gain): the LQR of :func:`aerostat_gym.agents.lqr.design_lqr`
+   (``subset="long"``) with its integral of the length error, or the modal design of
+   :func:`aerostat_gym.agents.modal.design_modal` on the same linear model (no integral: its
+   length loop is a placed pole);
 2. the same subset's zero-order-hold model x_{k+1} = Ad x_k + Bd u_k + w_k (u the set-point);
 3. measurements y = C x + v from the standard observation (:data:`MEASURED`): CM displacement
    and velocity along the wind and up, pitch, pitch rate, winch tension minus trim (its row is
@@ -25,7 +29,8 @@ Filter, once per control step: predict x- = Ad x^ + Bd u_prev, correct x^ = x- +
 The estimation error e = x - x^ then obeys e_k = (I - L C) Ad e_{k-1} + noise terms, so without
 noise it decays with the eigenvalues of (I - L C) Ad: the designed estimator rate
 (:attr:`LQGDesign.estimator_poles`). By the separation principle the closed loop's poles are the
-LQR's and the estimator's, so its linear pendulum damping is the LQR's.
+state feedback's and the estimator's, so its linear pendulum damping is the LQR's (or the
+modal design's placed ratio).
 
 The schedule interpolates every matrix linearly in U, and U itself is estimated from the
 measured along-wind air velocity at the aerostat (channel 16), low-passed with time constant
@@ -47,6 +52,7 @@ from ..params import Params
 from ..physics.state import StateLayout
 from ..sim import Model
 from .lqr import DEFAULT_SPEEDS, LQRDesign, design_lqr, discretize
+from .modal import default_zeta, design_modal
 
 #: Standard observation channels the filter uses (name -> index), all longitudinal.
 MEASURED = {"dx": 0, "dz": 2, "vx": 3, "vz": 5, "dpitch": 7, "q": 10, "dtension": 13,
@@ -55,6 +61,8 @@ MEASURED = {"dx": 0, "dz": 2, "vx": 3, "vz": 5, "dpitch": 7, "q": 10, "dtension"
 WIND_CHANNEL = 16
 #: Time constant of the wind-speed estimate [s].
 WIND_TIME_CONSTANT = 20.0
+#: State feedbacks the filter's estimate can drive (``gains``).
+GAINS = ("lqr", "modal")
 #: Sensor noise the filter is designed for when the environment's obs_noise is 0 (scaled units).
 MIN_NOISE = 1.0e-3
 #: Per-step process-noise standard deviation of each state group (SI units).
@@ -173,6 +181,10 @@ class LQGDesign:
         Gain on the integral of the length error.
     obs_noise : float
         Sensor noise (scaled units) the filter was designed for.
+    gains : str
+        The state feedback: "lqr" or "modal".
+    modes : dict
+        The state feedback's predicted modes (its ``summary()``).
     """
 
     lqr: LQRDesign = field(repr=False)
@@ -187,6 +199,8 @@ class LQGDesign:
     K: np.ndarray
     K_integral: float
     obs_noise: float
+    gains: str = "lqr"
+    modes: dict = field(default_factory=dict)
 
     @property
     def wind_speed(self) -> float:
@@ -203,20 +217,21 @@ class LQGDesign:
         return np.linalg.eigvals(self.error_matrix)
 
     def summary(self) -> dict:
-        """The LQR's predicted modes (separation principle: the LQG's closed-loop pendulum,
-        pitching and axial-spring modes are the LQR's), plus the slowest estimator pole."""
+        """The state feedback's predicted modes (separation principle: the closed loop's
+        pendulum, pitching and axial-spring modes are the state feedback's), plus the slowest
+        estimator pole."""
         z = self.estimator_poles
         zmax = z[np.argmax(np.abs(z))]
         s = np.log(complex(zmax)) / self.lqr.dt
-        return {**self.lqr.summary(),
+        return {**self.modes,
                 "estimator": {"spectral_radius": float(abs(zmax)),
                               "slowest_time_constant_s": float(-1.0 / s.real)}}
 
 
 def design_lqg(params: Params, wind_speed: float, dt: float = 0.2, obs_noise: float = 0.0, *,
                process_noise: dict | None = None, weights: dict | None = None,
-               equilibrium=None) -> LQGDesign:
-    """Kalman filter + LQR at one wind speed (see the module docstring).
+               equilibrium=None, gains: str = "lqr") -> LQGDesign:
+    """Kalman filter + state feedback at one wind speed (see the module docstring).
 
     Parameters
     ----------
@@ -234,21 +249,33 @@ def design_lqg(params: Params, wind_speed: float, dt: float = 0.2, obs_noise: fl
         LQR weight overrides (:data:`aerostat_gym.agents.lqr.DEFAULT_WEIGHTS`).
     equilibrium : Equilibrium or None
         A trim at ``wind_speed`` to reuse.
+    gains : str
+        "lqr" (the LQR's gains and length integral) or "modal" (the modal pole placement at
+        :func:`aerostat_gym.agents.modal.default_zeta`, no integral).
 
     Returns
     -------
     LQGDesign
     """
+    if gains not in GAINS:
+        raise ValueError(f"gains must be one of {GAINS}, got {gains!r}")
     eq = equilibrium or find_equilibrium(params, float(wind_speed))
     lqr = design_lqr(params, float(wind_speed), dt, weights, equilibrium=eq, subset="long")
     idx = lqr.mode_index[:-1]
+    if gains == "modal":
+        modal = design_modal(params, float(wind_speed), default_zeta(wind_speed), dt,
+                             equilibrium=eq, lqr=lqr)
+        K, K_integral, modes = modal.K[idx].copy(), 0.0, modal.summary()
+    else:
+        K, K_integral, modes = lqr.K[idx].copy(), lqr.K_integral, lqr.summary()
     Ad, Bd = discretize(lqr.linear.A_free[np.ix_(idx, idx)], lqr.linear.B[idx], dt)
     C = measurement_matrix(params, lqr, idx)
     R = measurement_noise(obs_noise)
     W = _process_noise(lqr.linear.layout, idx, process_noise or {})
     P, L = kalman_gain(Ad, C, W, R)
     return LQGDesign(lqr=lqr, index=idx, Ad=Ad, Bd=Bd, C=C, R=R, W=W, P=P, L=L,
-                     K=lqr.K[idx].copy(), K_integral=lqr.K_integral, obs_noise=float(obs_noise))
+                     K=K, K_integral=float(K_integral), obs_noise=float(obs_noise), gains=gains,
+                     modes=modes)
 
 
 class LQGSchedule:
@@ -266,10 +293,12 @@ class LQGSchedule:
         Sensor noise the filters are designed for (scaled units).
     process_noise : dict or None
         Overrides of :data:`DEFAULT_PROCESS_NOISE`.
+    gains : str
+        The state feedback on the estimate, "lqr" or "modal" (:func:`design_lqg`).
     """
 
     def __init__(self, params: Params, speeds=None, dt: float = 0.2, obs_noise: float = 0.0,
-                 process_noise: dict | None = None):
+                 process_noise: dict | None = None, gains: str = "lqr"):
         speeds = np.asarray(DEFAULT_SPEEDS if speeds is None else speeds, float).ravel()
         if speeds.size == 0 or np.any(np.diff(speeds) <= 0) or np.any(speeds < 0):
             raise ValueError(f"speeds must be non-negative and strictly increasing, got {speeds}")
@@ -277,7 +306,7 @@ class LQGSchedule:
         for U in speeds:
             eq = find_equilibrium(params, float(U), guess=eq)
             designs.append(design_lqg(params, float(U), dt, obs_noise,
-                                      process_noise=process_noise, equilibrium=eq))
+                                      process_noise=process_noise, equilibrium=eq, gains=gains))
         self.params, self.speeds, self.dt, self.designs = params, speeds, float(dt), designs
         self.index = designs[0].index
         self.tables = {name: np.array([getattr(d, name) for d in designs])
@@ -313,6 +342,8 @@ class LQGPolicy:
         The environment's sensor noise (scaled units); designs the filters.
     schedule : LQGSchedule or None
         The design table (default: built here over 2-16 m/s).
+    gains : str
+        The state feedback of the default table, "lqr" or "modal".
 
     Notes
     -----
@@ -327,10 +358,10 @@ class LQGPolicy:
     obs_dim = N_OBS
 
     def __init__(self, params: Params, dt: float = 0.2, obs_noise: float = 0.0,
-                 schedule: LQGSchedule | None = None):
+                 schedule: LQGSchedule | None = None, gains: str = "lqr"):
         self.params = params
         self.dt = float(dt)
-        self.schedule = schedule or LQGSchedule(params, dt=dt, obs_noise=obs_noise)
+        self.schedule = schedule or LQGSchedule(params, dt=dt, obs_noise=obs_noise, gains=gains)
         if abs(self.schedule.dt - self.dt) > 1e-12:
             raise ValueError(f"schedule was designed for dt = {self.schedule.dt} s, policy "
                              f"dt = {self.dt} s")

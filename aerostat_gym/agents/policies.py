@@ -5,7 +5,10 @@ deterministic)`` signature, so one evaluator runs baselines and trained models a
 - :class:`TensionFeedbackPolicy`: a compliant winch, reeling out when the tension exceeds its
   trim value and back in slowly toward the trim length.
 - :class:`aerostat_gym.agents.lqr.LQRPolicy`: gain-scheduled LQR on the linear model
-  (privileged full state).
+  (privileged full state); :class:`aerostat_gym.agents.modal.ModalPolicy` the same with the
+  modal gains.
+- :class:`aerostat_gym.agents.lqg.LQGPolicy`: a Kalman filter on the standard observation with
+  the LQR's (``lqg``) or the modal design's (``modal_lqg``) gains.
 - :class:`aerostat_gym.agents.sb3io.SB3Policy`: a trained model with its VecNormalize
   statistics.
 
@@ -28,7 +31,7 @@ from .modal import ModalPolicy
 from .residual import check_residual
 from .sb3io import PolicyError, as_batch, load_sb3, to_actions
 
-BASELINES = ("passive", "tension", "lqr", "modal", "lqg")
+BASELINES = ("passive", "tension", "lqr", "modal", "lqg", "modal_lqg")
 #: Names of trained policies that ship with the package.
 SHIPPED = {"shipped": SHIPPED_POLICY}
 #: Tension feedback in units of the configuration: reel speed per tension excess, as a fraction
@@ -99,7 +102,8 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     Baselines: 'passive' (braked winch), 'tension' (tension feedback), 'lqr' (gain-scheduled
     LQR over the wind range, privileged full state), 'modal' (pendulum pole placement,
     privileged full state), 'lqg' (Kalman filter on the standard channels designed for the
-    sensor noise ``obs_noise``, with the LQR gains).
+    sensor noise ``obs_noise``, with the LQR gains), 'modal_lqg' (the same filter driving the
+    modal gains: the frontier controller on the information a learned policy has).
 
     A saved model's wrapper metadata (``<stem>_wrappers.json``) is honoured: its frame stack,
     and its residual base rebuilt for ``params`` and ``dt`` with the sensor noise it was
@@ -121,6 +125,8 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
         return ModalPolicy(params, dt=dt)
     if name == "lqg":
         return LQGPolicy(params, dt=dt, obs_noise=obs_noise)
+    if name == "modal_lqg":
+        return LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal")
     if name in SHIPPED:
         return load_sb3(shipped_path(SHIPPED[name]), base_factory)
     if name.endswith(".zip") or Path(name).exists():

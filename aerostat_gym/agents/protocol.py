@@ -130,7 +130,7 @@ def paired_verdict(diff: Interval, metric: str) -> str:
 
 def _values(result: dict, scenario: str, speed: float, metric: str) -> tuple[list, np.ndarray]:
     eps = sorted((e for e in result["scenarios"][scenario]["episodes"]
-                  if e["wind_speed"] == speed), key=lambda e: e["seed"])
+                  if e["wind_speed"] == speed), key=lambda e: (e.get("group", 0), e["seed"]))
     vals = [e.get(metric) for e in eps]
     return [e["seed"] for e in eps], np.array(
         [v if isinstance(v, (int, float)) and not isinstance(v, bool) else np.nan for v in vals],
@@ -230,21 +230,44 @@ def aggregate_cells(results: list[dict]) -> list[tuple[str, float]]:
     return [c for c in cells if n[c] == top]
 
 
+def pool_training_seeds(results: list[dict], label: str) -> dict:
+    """One result of several trainings of the same configuration (one result per training
+    seed, each on the same suite): every cell's episodes, seed-major, and ``groups``, the number
+    of training seeds, which :func:`aggregate` resamples hierarchically (training seeds, then
+    episodes), so its intervals carry the spread between training seeds."""
+    if not results:
+        raise ValueError("pool_training_seeds needs at least one result")
+    _check_paired(results)
+    pooled = {k: v for k, v in results[0].items() if k != "scenarios"}
+    pooled["scenarios"] = {
+        name: {"episodes": [{**e, "group": g} for g, r in enumerate(results)
+                            for e in r["scenarios"][name]["episodes"]]}
+        for name in results[0]["scenarios"]}
+    pooled.update(label=label, groups=len(results),
+                  members=[r["label"] for r in results])
+    return pooled
+
+
 def aggregate(results: list[dict], seed: int = 0) -> dict:
     """IQM of the normalised score with its stratified-bootstrap interval and the probability
-    of improvement of each policy over each other one (see the module notes)."""
+    of improvement of each policy over each other one (see the module notes). A pooled result
+    (:func:`pool_training_seeds`) is resampled over its training seeds and their episodes."""
     ref, mats = scores(results)
+    groups = {r["label"]: int(r.get("groups", 1)) for r in results}
     agg = {}
     for lab, s in mats.items():
         if s.shape[0] < 2:  # one seed per cell: no interval over runs
             iv = Interval(float(np.mean(s)), math.nan, math.nan, 0.95, 1)
         else:
-            iv = iqm_ci(s, seed=seed)
+            iv = iqm_ci(s, seed=seed, groups=groups[lab])
         row = {"iqm": iv.estimate, "iqm_ci": [iv.low, iv.high], "p_improvement": {}}
+        if groups[lab] > 1:
+            row["training_seeds"] = groups[lab]
         for other, t in mats.items():
             if other == lab or s.shape[0] < 2:
                 continue
-            p = probability_of_improvement_ci(s, t, seed=seed)
+            p = probability_of_improvement_ci(s, t, seed=seed, groups_x=groups[lab],
+                                              groups_y=groups[other])
             row["p_improvement"][other] = {"p": p.estimate, "ci": [p.low, p.high]}
         agg[lab] = row
     cells = aggregate_cells(results)

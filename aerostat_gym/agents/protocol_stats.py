@@ -258,16 +258,37 @@ def stratified_resample(scores: np.ndarray, rng: np.random.Generator) -> np.ndar
     return np.take_along_axis(scores, idx, axis=0)
 
 
-def _stratified_batch(scores: np.ndarray, rng: np.random.Generator, resamples: int
-                      ) -> np.ndarray:
-    """``resamples`` stratified replicates at once, shape (resamples, runs, tasks)."""
+def _check_groups(scores: np.ndarray, groups: int, name: str) -> int:
+    """The number of equal row blocks (training seeds) of a (runs, tasks) matrix."""
+    if isinstance(groups, bool) or not isinstance(groups, int | np.integer) or groups < 1:
+        raise StatsInputError(f"{name}: groups must be an integer >= 1, got {groups!r}")
+    if scores.shape[0] % groups or (groups > 1 and scores.shape[0] // groups < 2):
+        raise StatsInputError(f"{name}: {scores.shape[0]} runs do not split into {groups} "
+                              "equal groups of at least 2 runs")
+    return int(groups)
+
+
+def _stratified_batch(scores: np.ndarray, rng: np.random.Generator, resamples: int,
+                      groups: int = 1) -> np.ndarray:
+    """``resamples`` stratified replicates at once, shape (resamples, runs, tasks).
+
+    With ``groups`` > 1 the runs are that many equal blocks in order (one per training seed,
+    its evaluation episodes inside) and the resampling is hierarchical within each task: the
+    blocks are drawn with replacement, then the runs inside each drawn block, so the interval
+    carries the spread between training seeds as well as between episodes."""
     runs, tasks = scores.shape
-    idx = rng.integers(0, runs, size=(resamples, runs, tasks))
-    return scores[idx, np.arange(tasks)[None, None, :]]
+    cols = np.arange(tasks)[None, None, :]
+    if groups == 1:
+        idx = rng.integers(0, runs, size=(resamples, runs, tasks))
+        return scores[idx, cols]
+    size = runs // groups
+    block = rng.integers(0, groups, size=(resamples, groups, 1, tasks))
+    inner = rng.integers(0, size, size=(resamples, groups, size, tasks))
+    return scores[(block * size + inner).reshape(resamples, runs, tasks), cols]
 
 
 def iqm_ci(scores, confidence: float = DEFAULT_CONFIDENCE, resamples: int = DEFAULT_RESAMPLES,
-           seed: int = 0) -> Interval:
+           seed: int = 0, groups: int = 1) -> Interval:
     """Interquartile mean of a (runs, tasks) matrix with a stratified-bootstrap percentile
     interval.
 
@@ -281,6 +302,9 @@ def iqm_ci(scores, confidence: float = DEFAULT_CONFIDENCE, resamples: int = DEFA
         Bootstrap resamples.
     seed : int
         Seed of the resampling generator.
+    groups : int
+        Equal blocks of runs (training seeds, each block its evaluation episodes), resampled
+        hierarchically (:func:`_stratified_batch`); 1: the runs are independent.
 
     Returns
     -------
@@ -289,7 +313,8 @@ def iqm_ci(scores, confidence: float = DEFAULT_CONFIDENCE, resamples: int = DEFA
     """
     _check_level(confidence, resamples)
     s = _matrix(scores, "scores")
-    boot = stats.trim_mean(_stratified_batch(s, np.random.default_rng(seed), resamples)
+    groups = _check_groups(s, groups, "scores")
+    boot = stats.trim_mean(_stratified_batch(s, np.random.default_rng(seed), resamples, groups)
                            .reshape(resamples, -1), 0.25, axis=1)
     lo, hi = _percentile(boot, 1.0 - confidence)
     return Interval(interquartile_mean(s), lo, hi, float(confidence), int(s.shape[0]))
@@ -325,18 +350,28 @@ def probability_of_improvement(x, y) -> float:
     return float(np.mean(_poi_per_task(xs, ys)))
 
 
+#: Bootstrap replicates compared at once in :func:`probability_of_improvement_ci` (bounds the
+#: memory of the pairwise comparison).
+POI_CHUNK = 250
+
+
 def probability_of_improvement_ci(x, y, confidence: float = DEFAULT_CONFIDENCE,
-                                  resamples: int = DEFAULT_RESAMPLES, seed: int = 0) -> Interval:
+                                  resamples: int = DEFAULT_RESAMPLES, seed: int = 0,
+                                  groups_x: int = 1, groups_y: int = 1) -> Interval:
     """:func:`probability_of_improvement` with a stratified-bootstrap percentile interval (the
-    runs of x and of y resampled independently within each task)."""
+    runs of x and of y resampled independently within each task; hierarchically over
+    ``groups_x`` / ``groups_y`` equal blocks of training seeds, see :func:`_stratified_batch`)."""
     _check_level(confidence, resamples)
     xs, ys = _matrix(x, "x"), _matrix(y, "y")
+    gx, gy = _check_groups(xs, groups_x, "x"), _check_groups(ys, groups_y, "y")
     estimate = probability_of_improvement(xs, ys)
     rng = np.random.default_rng(seed)
-    xb, yb = _stratified_batch(xs, rng, resamples), _stratified_batch(ys, rng, resamples)
-    gt = (xb[:, :, None, :] > yb[:, None, :, :]).mean(axis=(1, 2))
-    eq = (xb[:, :, None, :] == yb[:, None, :, :]).mean(axis=(1, 2))
-    boot = np.mean(gt + 0.5 * eq, axis=1)
+    xb, yb = _stratified_batch(xs, rng, resamples, gx), _stratified_batch(ys, rng, resamples, gy)
+    boot = np.empty(resamples)
+    for k in range(0, resamples, POI_CHUNK):
+        a, b = xb[k:k + POI_CHUNK, :, None, :], yb[k:k + POI_CHUNK, None, :, :]
+        gt, eq = (a > b).mean(axis=(1, 2)), (a == b).mean(axis=(1, 2))
+        boot[k:k + POI_CHUNK] = np.mean(gt + 0.5 * eq, axis=1)
     lo, hi = _percentile(boot, 1.0 - confidence)
     return Interval(estimate, lo, hi, float(confidence), int(min(xs.shape[0], ys.shape[0])))
 

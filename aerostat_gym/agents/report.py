@@ -11,6 +11,7 @@ import numpy as np
 from ..resources import SHIPPED_POLICY
 from . import protocol as proto_mod
 from .evaluate import SCENARIOS, describe_suite, evaluate_policy
+from .policies import BASELINES
 from .protocol_stats import bootstrap_mean_ci
 
 COLUMNS = [  # (key, header, format)
@@ -93,7 +94,7 @@ def verdicts(results: list[dict]) -> list[str]:
     by = {r["label"]: r for r in results}
     out = []
     for r in results:
-        if r["label"] in ("passive", "tension", "lqr", "modal", "lqg"):
+        if r["label"] in BASELINES:
             continue
         for ref in ("passive", "lqr"):
             if ref not in by:
@@ -316,13 +317,25 @@ def cell_means(episodes: list[dict]) -> list[dict]:
 def run_evaluations(policies: list[str], suite: str, progress: bool = True,
                     params=None) -> list[dict]:
     """Evaluate every policy on ``suite`` in the environment of ``params`` (default baseline)."""
+    labels = policy_labels(policies)
     results = []
-    for name in _progress(policies, progress, "evaluating"):
+    for name, label in zip(_progress(policies, progress, "evaluating"), labels, strict=True):
         r = evaluate_policy(name, suite, params=params)
-        r["label"] = Path(name).stem if name.endswith(".zip") else (
-            Path(SHIPPED_POLICY).stem if name == "shipped" else name)
+        r["label"] = label
         results.append(r)
     return results
+
+
+def policy_labels(policies: list[str]) -> list[str]:
+    """The label of each policy in tables: a baseline's name, the shipped policy's file stem, a
+    saved model's file stem, or (where two models share a stem, e.g. ``ppo_final.zip`` of two
+    runs) its run directory and stem. The same policy twice is refused."""
+    if len(set(policies)) != len(policies):
+        raise ValueError(f"a policy is listed twice: {policies}")
+    stems = [Path(n).stem if n.endswith(".zip") else (
+        Path(SHIPPED_POLICY).stem if n == "shipped" else n) for n in policies]
+    return [f"{Path(n).parent.name}/{st}" if stems.count(st) > 1 and n.endswith(".zip") else st
+            for n, st in zip(policies, stems, strict=True)]
 
 
 def _progress(items, enabled: bool, desc: str):

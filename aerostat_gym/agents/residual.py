@@ -3,7 +3,8 @@ clip(base_action + scale * policy_action, -1, 1), where the base policy is a bas
 the standard observation (:data:`RESIDUAL_BASES`) and keeps its own state across steps.
 
 Learned and classical policies are compared on equal information, so the privileged baselines
-(LQR and modal pole placement read the full state) are refused as bases.
+(LQR and modal pole placement read the full state) are refused as bases; their output-feedback
+forms (``lqg``, ``modal_lqg``: the same gains on a Kalman filter's estimate) are allowed.
 
 - :func:`check_residual`: the validated ``residual`` block of a training configuration.
 - :func:`residual_vec_env`: the SB3 ``VecEnvWrapper`` that applies the base policy during
@@ -24,7 +25,7 @@ from ..envs.spaces import N_OBS
 from .sb3io import PolicyError
 
 #: Baselines that read the standard observation only, allowed as residual bases.
-RESIDUAL_BASES = ("lqg", "tension")
+RESIDUAL_BASES = ("lqg", "modal_lqg", "tension")
 #: Baselines that read the privileged full state: refused.
 PRIVILEGED_BASES = ("lqr", "modal")
 

@@ -21,8 +21,9 @@ from ..envs.config import DEFAULT_WIND_RANGE
 from .evaluate import RECOVER_SCENARIOS, SCENARIOS, episode_metrics, run_scenario
 from .policies import load_policy
 
-#: The classical baselines the score is checked on.
-BASELINES = ("passive", "tension", "lqr", "modal", "lqg")
+#: The classical baselines the score's rank correlation was measured on (0.3's five; the
+#: README's 0.77 / 0.83 are theirs).
+RANKED_BASELINES = ("passive", "tension", "lqr", "modal", "lqg")
 RANK_SPEEDS = (3.0, 5.0, 7.5, 10.0, 12.5, 15.0)
 
 
@@ -31,8 +32,8 @@ def damping_key(scenario: str) -> str:
     return "pendulum_zeta" if "x" in SCENARIOS[scenario].pendulums else "lateral_pendulum_zeta"
 
 
-def rank_rows(params, policies=BASELINES, scenarios=RECOVER_SCENARIOS, speeds=RANK_SPEEDS,
-              control_step: float = 0.2) -> list[dict]:
+def rank_rows(params, policies=RANKED_BASELINES, scenarios=RECOVER_SCENARIOS,
+              speeds=RANK_SPEEDS, control_step: float = 0.2) -> list[dict]:
     """One row per (policy, scenario, wind speed): return and damping ratio (seed 0)."""
     rows = []
     for name in policies:

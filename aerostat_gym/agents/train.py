@@ -15,7 +15,8 @@ separate top-level block ``aerostat_gym``:
   see the pendulum's phase and rate.
 - ``residual: {base: lqg, scale: 0.3}``: the action sent to the environment is
   clip(base + scale * action, -1, 1), with ``base`` a baseline that reads the standard
-  observation (``lqg`` or ``tension``; the privileged ``lqr`` and ``modal`` are refused),
+  observation (``lqg``, ``modal_lqg`` or ``tension``; the privileged ``lqr`` and ``modal``
+  are refused),
   designed for the training configuration and the training sensor noise, keeping its own
   state and reset at every episode start (:mod:`aerostat_gym.agents.residual`).
 

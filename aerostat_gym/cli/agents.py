@@ -7,7 +7,7 @@ import sys
 import time
 
 from ..agents.evaluate import SUITES
-from ..agents.policies import load_policy
+from ..agents.policies import BASELINES, load_policy
 from ..agents.report import (
     comparison_table,
     jsonable,
@@ -57,7 +57,7 @@ def _train_command(args) -> int:
 def add_evaluate_parser(sub) -> None:
     p = sub.add_parser("evaluate", help="evaluate policies on a frozen seed suite")
     p.add_argument("--policy", action="append", required=True,
-                   help="passive, tension, lqr, modal, lqg, shipped or PATH.zip (repeat to compare)")
+                   help=f"{', '.join(BASELINES)}, shipped or PATH.zip (repeat to compare)")
     p.add_argument("--suite", choices=list(SUITES), default="tiny",
                    help="frozen seed suite (scenario: wind speeds, seeds); 'report' is the "
                    "protocol of the README's baseline table (writes protocol.md)")

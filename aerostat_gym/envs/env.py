@@ -185,6 +185,9 @@ class TetheredAerostatEnv(gym.Env):
       the drum; the stand-still clock is part of ``get_state``. Trims and the braked dynamics
       are unchanged. New task id ``TetheredAerostatDampingNoisy-v0`` (the damping task with the
       evaluation protocol's sensor noise, 0.01), the shipped policy's task.
+    - v0 (aerostat-gym 0.4; dynamics, observation and reward unchanged): new task id
+      ``TetheredAerostatRealistic-v0`` (light turbulence, swing perturbations, randomised
+      estimated parameters, sensor noise 0.01), the shipped policy's task.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
