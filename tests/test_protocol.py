@@ -281,3 +281,15 @@ def test_pooled_training_seeds_keep_seed_blocks():
     assert "min -0.700, median -0.600, max -0.500" in seed_spread_markdown(spread)
     with pytest.raises(ValueError, match="distinct"):
         pool_training_seeds([runs[0], runs[0]], "cfg")
+
+
+def test_policy_labels_stay_distinct():
+    """Two runs' ppo_final.zip are told apart by their run directory; a baseline keeps its
+    name, the shipped policy its file stem; the same policy twice is refused."""
+    from aerostat_gym.agents.report import policy_labels
+
+    assert policy_labels(["passive", "shipped", "runs/a/ppo_final.zip", "runs/b/ppo_final.zip",
+                          "x/model.zip"]) == ["passive", "ppo_tethered_aerostat", "a/ppo_final",
+                                              "b/ppo_final", "model"]
+    with pytest.raises(ValueError, match="listed twice"):
+        policy_labels(["lqr", "lqr"])
