@@ -52,7 +52,7 @@ from ..params import Params
 from ..physics.state import StateLayout
 from ..sim import Model
 from .lqr import DEFAULT_SPEEDS, LQRDesign, design_lqr, discretize
-from .modal import default_zeta, design_modal
+from .modal import design_modal
 
 #: Standard observation channels the filter uses (name -> index), all longitudinal.
 MEASURED = {"dx": 0, "dz": 2, "vx": 3, "vz": 5, "dpitch": 7, "q": 10, "dtension": 13,
@@ -263,8 +263,7 @@ def design_lqg(params: Params, wind_speed: float, dt: float = 0.2, obs_noise: fl
     lqr = design_lqr(params, float(wind_speed), dt, weights, equilibrium=eq, subset="long")
     idx = lqr.mode_index[:-1]
     if gains == "modal":
-        modal = design_modal(params, float(wind_speed), default_zeta(wind_speed), dt,
-                             equilibrium=eq, lqr=lqr)
+        modal = design_modal(params, float(wind_speed), dt=dt, equilibrium=eq, lqr=lqr)
         K, K_integral, modes = modal.K[idx].copy(), 0.0, modal.summary()
     else:
         K, K_integral, modes = lqr.K[idx].copy(), lqr.K_integral, lqr.summary()

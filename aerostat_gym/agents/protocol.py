@@ -128,7 +128,9 @@ def paired_verdict(diff: Interval, metric: str) -> str:
     return verdict(diff, higher_is_better=metric not in LOWER_IS_BETTER)
 
 
-def _values(result: dict, scenario: str, speed: float, metric: str) -> tuple[list, np.ndarray]:
+def cell_values(result: dict, scenario: str, speed: float, metric: str) -> tuple[list, np.ndarray]:
+    """(seeds, values) of ``metric`` over a cell's episodes, ordered by training seed (pooled
+    results) then evaluation seed; a missing or non-numeric value reads NaN."""
     eps = sorted((e for e in result["scenarios"][scenario]["episodes"]
                   if e["wind_speed"] == speed), key=lambda e: (e.get("group", 0), e["seed"]))
     vals = [e.get(metric) for e in eps]
@@ -148,7 +150,7 @@ def _check_paired(results: list[dict]) -> None:
     if len(set(labels)) != len(labels):
         raise ValueError(f"policy labels must be distinct, got {labels}")
     for s, u in _cells(results):
-        seeds = {tuple(_values(r, s, u, "return")[0]) for r in results}
+        seeds = {tuple(cell_values(r, s, u, "return")[0]) for r in results}
         if len(seeds) != 1:
             raise ValueError(f"cell ({s}, {u:g} m/s): the policies ran different seeds; the "
                              "protocol pairs episodes by seed (evaluate them on one suite)")
@@ -181,7 +183,7 @@ def protocol(results: list[dict], baselines=BASELINES, seed: int = 0) -> dict:
     for s, u in _cells(results):
         cell = {"scenario": s, "wind_speed": u, "policies": {}, "paired": {}}
         metrics = scenario_metrics(s)
-        vals = {r["label"]: {m: _values(r, s, u, m)[1] for m in metrics} for r in results}
+        vals = {r["label"]: {m: cell_values(r, s, u, m)[1] for m in metrics} for r in results}
         cell["n_seeds"] = int(len(vals[labels[0]]["return"]))
         for lab in labels:
             cell["policies"][lab] = {}
@@ -214,10 +216,10 @@ def scores(results: list[dict]) -> tuple[str, dict]:
     by = {r["label"]: r for r in results}
     cols = {lab: [] for lab in labels}
     for s, u in aggregate_cells(results):
-        norm = abs(float(np.mean(_values(by[ref], s, u, "return")[1])))
+        norm = abs(float(np.mean(cell_values(by[ref], s, u, "return")[1])))
         norm = norm if norm > 0.0 else 1.0
         for lab in labels:
-            cols[lab].append(_values(by[lab], s, u, "return")[1] / norm)
+            cols[lab].append(cell_values(by[lab], s, u, "return")[1] / norm)
     return ref, {lab: np.column_stack(c) for lab, c in cols.items()}
 
 
@@ -225,7 +227,7 @@ def aggregate_cells(results: list[dict]) -> list[tuple[str, float]]:
     """The cells the aggregate pools: those with the most seeds (a score matrix needs the same
     runs in every column; in the report suites that is every cell)."""
     cells = _cells(results)
-    n = {c: len(_values(results[0], *c, "return")[0]) for c in cells}
+    n = {c: len(cell_values(results[0], *c, "return")[0]) for c in cells}
     top = max(n.values())
     return [c for c in cells if n[c] == top]
 

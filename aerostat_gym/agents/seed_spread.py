@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .protocol import _values, aggregate, pool_training_seeds
+from .protocol import aggregate, cell_values, pool_training_seeds
 
 #: The recover cells whose pendulum damping the per-seed table shows.
 DAMPING_CELLS = (("recover", 5.0), ("recover", 10.0), ("recover", 15.0))
@@ -26,7 +26,7 @@ def _mean(result: dict, scenario: str, speed: float, metric: str) -> float:
     """Mean of the finite values over the cell's episodes (NaN: no such cell or value)."""
     if scenario not in result["scenarios"]:
         return float("nan")
-    v = _values(result, scenario, speed, metric)[1]
+    v = cell_values(result, scenario, speed, metric)[1]
     v = v[np.isfinite(v)]
     return float(np.mean(v)) if v.size else float("nan")
 
