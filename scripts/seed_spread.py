@@ -1,13 +1,17 @@
 """The spread of a training configuration over its training seeds on the report suite.
 
-Reads the ``report.json`` of one ``aerostat-gym evaluate --suite report`` run that evaluated
-the baselines and one model per training seed, and writes per-seed and pooled aggregate tables
+Reads the ``report.json`` of ``aerostat-gym evaluate --suite report`` runs (one or several, on
+the same suite) that evaluated the baselines and one model per training seed, and writes
+per-seed and pooled aggregate tables to ``seeds.md`` and ``seeds.json``
 (:mod:`aerostat_gym.agents.seed_spread`). Usage::
 
-    aerostat-gym evaluate --suite report --out runs/seeds --policy passive ... \\
-        --policy runs/train/s0/ppo_final.zip ... --policy runs/train/s4/ppo_final.zip
-    PYTHONPATH=. python scripts/seed_spread.py runs/seeds/report.json --label residual-PPO \\
-        --seeds s0/ppo_final s1/ppo_final ... --out agents/ppo_training/seeds
+    aerostat-gym evaluate --suite report --out agents/baseline_report --policy passive ... \\
+        --policy shipped
+    aerostat-gym evaluate --suite report --out runs/seeds/eval --no-plots \\
+        --policy runs/seeds/s1/ppo_final.zip ... --policy runs/seeds/s4/ppo_final.zip
+    PYTHONPATH=. python scripts/seed_spread.py agents/baseline_report/report.json \\
+        runs/seeds/eval/report.json --seeds ppo_tethered_aerostat s1/ppo_final ... s4/ppo_final \\
+        --label "shipped configuration" --out agents/ppo_training
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .protocol import aggregate, cell_values, pool_training_seeds
+from .protocol import aggregate, aggregate_markdown, cell_values, pool_training_seeds
 
 #: The recover cells whose pendulum damping the per-seed table shows.
 DAMPING_CELLS = (("recover", 5.0), ("recover", 10.0), ("recover", 15.0))
@@ -80,13 +80,5 @@ def seed_spread_markdown(spread: dict) -> str:
            f"{s['median']:.3f}, max {s['max']:.3f}.", "",
            f"Pooled ({spread['label']}: every seed's episodes; intervals from a hierarchical "
            "bootstrap over training seeds, then episodes). Score: " + spread["score"] + ".", ""]
-    agg = spread["pooled"]
-    labels = list(agg)
-    head = ["policy", "IQM [95 % CI]", *(f"P(better than {o})" for o in labels)]
-    rows = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for lab in labels:
-        lo, hi = agg[lab]["iqm_ci"]
-        rows.append("| " + " | ".join([lab, f"{agg[lab]['iqm']:.3f} [{lo:.3f}, {hi:.3f}]", *(
-            "-" if o == lab else _p(agg[lab]["p_improvement"][o]) for o in labels)]) + " |")
-    out.append("\n".join(rows))
+    out.append(aggregate_markdown({"aggregate": spread["pooled"]}))
     return "\n".join(out) + "\n"
