@@ -142,11 +142,14 @@ def test_policy_frame_stack_matches_vecframestack():
     venv.close()
 
 
-def test_residual_evaluation_matches_training_wrapper():
+@pytest.mark.parametrize("deadband", [0.0, 0.1])
+def test_residual_evaluation_matches_training_wrapper(deadband):
     """The action the residual wrapper sends the environment in training equals SB3Policy's
-    residual action for the same policy output, across episode resets."""
+    residual action for the same policy output, across episode resets, with and without a
+    deadband (which, at 0.1 against residual commands of up to 0.3, zeroes some of them)."""
     env_kwargs = {**SMOKE_ENV, "max_episode_steps": 7}
-    spec = wrapper_spec({"residual": {"base": "lqg", "scale": 0.3}}, env_kwargs)
+    spec = wrapper_spec({"residual": {"base": "lqg", "scale": 0.3, "deadband": deadband}},
+                        env_kwargs)
     base = residual_base(spec, env_kwargs)
     venv = make_training_env(2, 0, env_kwargs, None, spec, base)
     inner = venv.venv
@@ -163,7 +166,8 @@ def test_residual_evaluation_matches_training_wrapper():
             return self.action, None
 
     model = Model()
-    policy = SB3Policy(model, None, residual=(load_policy("lqg", obs_noise=0.01), 0.3))
+    policy = SB3Policy(model, None,
+                       residual=(load_policy("lqg", obs_noise=0.01), 0.3, deadband))
     state, start, rng, ends = None, np.ones(2, bool), np.random.default_rng(1), 0
     for _ in range(20):
         model.action = rng.uniform(-1.5, 1.5, (2, 1)).astype(np.float32)
@@ -172,7 +176,34 @@ def test_residual_evaluation_matches_training_wrapper():
         np.testing.assert_array_equal(sent[-1], expected)
         start, ends = dones, ends + int(dones.sum())
     assert ends >= 2
+    zeros = sum(int(np.sum(a == 0.0)) for a in sent)
+    assert (zeros > 0) == (deadband > 0.0)
     venv.close()
+
+
+def test_residual_deadband_closed_form():
+    """combine_residual: clip(base + scale clip(policy)) with every |command| below the
+    deadband exactly zero (the brake's command); the deadband is validated at the door."""
+    from aerostat_gym.agents.residual import DeadbandPolicy, check_residual
+    from aerostat_gym.agents.sb3io import combine_residual
+
+    class Constant:
+        def __init__(self, action):
+            self.action = np.array(action, np.float32)
+
+        def predict(self, obs, state=None, episode_start=None, deterministic=True):
+            return self.action, state
+
+    out = combine_residual([0.02, -0.02, 0.5, 0.9], [0.05, 0.6, -2.0, 1.0], 0.1, 0.03)
+    np.testing.assert_allclose(out[:, 0], [0.0, 0.04, 0.4, 1.0], atol=1e-7)
+    np.testing.assert_array_equal(DeadbandPolicy(Constant([[0.02], [-0.5]]), 0.03).predict(
+        np.zeros((2, N_OBS)))[0], np.array([[0.0], [-0.5]], np.float32))
+    assert check_residual({"base": "modal_lqg", "scale": 0.1, "deadband": 0.03}) == {
+        "base": "modal_lqg", "scale": 0.1, "deadband": 0.03}
+    assert "deadband" not in check_residual({"base": "modal_lqg", "scale": 0.1})
+    for bad in (-0.1, 1.0, float("nan"), True, "0.1"):
+        with pytest.raises(PolicyError, match="deadband"):
+            check_residual({"base": "modal_lqg", "deadband": bad})
 
 
 @pytest.mark.parametrize("base", ["modal", "lqr"])

@@ -11,8 +11,9 @@ forms (``lqg``, ``modal_lqg``: the same gains on a Kalman filter's estimate) are
   training; it sits on the raw environment (below VecNormalize), so the base policy reads the
   observation the environment gives, and it resets the base policy's state at every episode
   start (the batch resets an environment in the same step its episode ends).
-- :func:`residual_action`: the combination, shared with :class:`aerostat_gym.agents.sb3io.SB3Policy`
-  at evaluation.
+- :func:`aerostat_gym.agents.sb3io.combine_residual`: the combination, shared by training and
+  :class:`aerostat_gym.agents.sb3io.SB3Policy` at evaluation; an optional ``deadband`` (a
+  fraction of the winch's top speed) zeroes, and so brakes, every smaller command.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import math
 import numpy as np
 
 from ..envs.spaces import N_OBS
-from .sb3io import PolicyError
+from .sb3io import PolicyError, apply_deadband, combine_residual
 
 #: Baselines that read the standard observation only, allowed as residual bases.
 RESIDUAL_BASES = ("lqg", "modal_lqg", "tension")
@@ -31,9 +32,12 @@ PRIVILEGED_BASES = ("lqr", "modal")
 
 
 def check_residual(spec) -> dict:
-    """The residual block {base, scale} validated (a clear PolicyError otherwise)."""
-    if not isinstance(spec, dict) or set(spec) - {"base", "scale"} or "base" not in spec:
-        raise PolicyError(f"residual must be a mapping {{base: NAME, scale: S}}, got {spec!r}")
+    """The residual block {base, scale[, deadband]} validated (a clear PolicyError otherwise);
+    the deadband is returned only when it is set."""
+    if not isinstance(spec, dict) or set(spec) - {"base", "scale", "deadband"} \
+            or "base" not in spec:
+        raise PolicyError("residual must be a mapping {base: NAME, scale: S[, deadband: D]}, "
+                          f"got {spec!r}")
     base = spec["base"]
     if base in PRIVILEGED_BASES:
         raise PolicyError(f"residual base {base!r} reads the privileged full state: learned and "
@@ -45,17 +49,22 @@ def check_residual(spec) -> dict:
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) \
             or not math.isfinite(scale) or not 0 < scale <= 2:
         raise PolicyError(f"residual scale must be a number in (0, 2], got {scale!r}")
-    return {"base": base, "scale": float(scale)}
+    out = {"base": base, "scale": float(scale)}
+    if "deadband" in spec:
+        out["deadband"] = check_deadband(spec["deadband"])
+    return out
 
 
-def residual_action(base_action, policy_action, scale: float) -> np.ndarray:
-    """clip(base + scale * clip(policy, -1, 1), -1, 1) as float32, shape (N, 1)."""
-    b = np.asarray(base_action, np.float64).reshape(-1)
-    a = np.clip(np.asarray(policy_action, np.float64).reshape(-1), -1.0, 1.0)
-    return np.clip(b + scale * a, -1.0, 1.0).astype(np.float32)[:, None]
+def check_deadband(d) -> float:
+    """A deadband: a fraction of the winch's top speed in [0, 1)."""
+    if isinstance(d, bool) or not isinstance(d, (int, float)) or not math.isfinite(d) \
+            or not 0 <= d < 1:
+        raise PolicyError(f"residual deadband is a fraction of the winch's top speed in [0, 1), "
+                          f"got {d!r}")
+    return float(d)
 
 
-def residual_vec_env(venv, base, scale: float):
+def residual_vec_env(venv, base, scale: float, deadband: float = 0.0):
     """``venv`` (a raw SB3 VecEnv giving the standard observation first) with the actions
     made residual on ``base`` (a policy with the SB3 ``predict`` signature)."""
     from stable_baselines3.common.vec_env import VecEnvWrapper
@@ -65,7 +74,7 @@ def residual_vec_env(venv, base, scale: float):
 
         def __init__(self):
             super().__init__(venv)
-            self.base, self.scale = base, float(scale)
+            self.base, self.scale, self.deadband = base, float(scale), float(deadband)
             self._obs, self._state = None, None
             self._start = np.ones(self.num_envs, bool)
 
@@ -77,7 +86,7 @@ def residual_vec_env(venv, base, scale: float):
         def step_async(self, actions):
             b, self._state = self.base.predict(self._obs[:, :N_OBS], state=self._state,
                                                episode_start=self._start, deterministic=True)
-            self.venv.step_async(residual_action(b, actions, self.scale))
+            self.venv.step_async(combine_residual(b, actions, self.scale, self.deadband))
 
         def step_wait(self):
             obs, rew, dones, infos = self.venv.step_wait()
@@ -85,3 +94,19 @@ def residual_vec_env(venv, base, scale: float):
             return obs, rew, dones, infos
 
     return ResidualVecEnv()
+
+
+class DeadbandPolicy:
+    """Any policy with its commands below ``deadband`` (a fraction of the winch's top speed) set
+    to zero, which brakes the drum: the deadband of the residual block applied after the fact,
+    to a baseline or a trained model, for studies of what it buys (``scripts/deadband_study.py``).
+    """
+
+    def __init__(self, policy, deadband: float):
+        self.policy, self.deadband = policy, check_deadband(deadband)
+        self.obs_dim = getattr(policy, "obs_dim", None)
+
+    def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
+        a, state = self.policy.predict(observation, state=state, episode_start=episode_start,
+                                       deterministic=deterministic)
+        return apply_deadband(a, self.deadband), state

@@ -111,9 +111,9 @@ class SB3Policy:
 
     ``frame_stack`` K > 1 stacks the last K normalised observations (oldest first, the
     newest last, zeros before the episode's first step: SB3's VecFrameStack on top of
-    VecNormalize). ``residual`` = (base policy, scale) adds the model's action times scale to
-    the base policy's (which reads the raw observation and keeps its own state), clipped to
-    [-1, 1]. The state passed back and forth is then a dict of the recurrent model's state,
+    VecNormalize). ``residual`` = (base policy, scale[, deadband]) adds the model's action times
+    scale to the base policy's (which reads the raw observation and keeps its own state), clipped
+    to [-1, 1] (:func:`combine_residual`). The state passed back and forth is then a dict of the recurrent model's state,
     the stack and the base policy's state; ``episode_start`` resets all three.
     """
 
@@ -159,11 +159,29 @@ class SB3Policy:
             a, _ = self.model.predict(obs, deterministic=deterministic)
         a = np.asarray(a, np.float64).reshape(-1)
         if self.residual is not None:
-            base, scale = self.residual
+            base, scale, *rest = self.residual
             b, state["base"] = base.predict(raw, state=state.get("base"), episode_start=start,
                                             deterministic=True)
-            a = np.asarray(b, np.float64).reshape(-1) + scale * np.clip(a, -1.0, 1.0)
+            a = combine_residual(b, a, scale, *rest)[:, 0]
         return to_actions(a, single), state
+
+
+def combine_residual(base_action, policy_action, scale: float,
+                     deadband: float = 0.0) -> np.ndarray:
+    """clip(base + scale * clip(policy, -1, 1), -1, 1) as float32, shape (N, 1), with every
+    command smaller in magnitude than ``deadband`` (a fraction of the winch's top speed) set
+    to exactly zero, which applies the brake: the residual's sum of a small base command and
+    sensor noise then holds the drum instead of reeling on noise."""
+    b = np.asarray(base_action, np.float64).reshape(-1)
+    a = np.clip(np.asarray(policy_action, np.float64).reshape(-1), -1.0, 1.0)
+    return apply_deadband(np.clip(b + scale * a, -1.0, 1.0), deadband)[:, None]
+
+
+def apply_deadband(action, deadband: float) -> np.ndarray:
+    """``action`` as float32 with every entry smaller in magnitude than ``deadband`` zero."""
+    out = np.array(action, np.float64)
+    out[np.abs(out) < deadband] = 0.0
+    return out.astype(np.float32)
 
 
 def _algorithms() -> list:
@@ -236,5 +254,5 @@ def load_sb3(path: str | Path, base_factory=None) -> SB3Policy:
             raise PolicyError(f"{path} is a residual policy on {spec.get('base')!r}: load it "
                               "with load_policy, which builds the base policy")
         residual = (base_factory(spec["base"], float(spec.get("obs_noise", 0.0))),
-                    float(spec["scale"]))
+                    float(spec["scale"]), float(spec.get("deadband", 0.0)))
     return SB3Policy(model, norm, frame_stack=k, residual=residual)

@@ -181,7 +181,8 @@ def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict 
     wrappers = wrappers or {}
     venv = VecMonitor(sb3_vec_env(n_envs, seed=seed, **env_kwargs))
     if wrappers.get("residual"):
-        venv = residual_vec_env(venv, base, wrappers["residual"]["scale"])
+        res = wrappers["residual"]
+        venv = residual_vec_env(venv, base, res["scale"], res.get("deadband", 0.0))
     if normalize is not None:
         if stats is not None and Path(stats).is_file():
             venv = VecNormalize.load(str(stats), venv)
@@ -197,7 +198,7 @@ def run_policy(model, wrappers: dict, base=None) -> SB3Policy:
     res = wrappers.get("residual")
     return SB3Policy(model, find_vecnormalize(model.get_env()),
                      frame_stack=wrappers.get("frame_stack", 1),
-                     residual=(base, res["scale"]) if res else None)
+                     residual=(base, res["scale"], res.get("deadband", 0.0)) if res else None)
 
 
 def _count(name: str, value) -> int:

@@ -1,0 +1,89 @@
+"""Deadband study: the report suite's aggregate and key cells for the braked winch, the modal
+controller, ``modal_lqg`` and given policies, each also with a command deadband added after the
+fact (:class:`aerostat_gym.agents.residual.DeadbandPolicy`), pooled by
+:func:`aerostat_gym.agents.protocol.aggregate` (the episodes are those of ``aerostat-gym
+evaluate --suite report``).
+
+Usage::
+
+    PYTHONPATH=. python scripts/deadband_study.py [--policy shipped] [--policy run/ppo_final.zip]
+        [--deadband 0.05] [--json out.json]
+
+About 2.5 minutes per policy on one core.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+
+from aerostat_gym.agents import protocol
+from aerostat_gym.agents.evaluate import SENSOR_NOISE, SUITES, episode_metrics, run_scenario
+from aerostat_gym.agents.policies import load_policy
+from aerostat_gym.agents.residual import DeadbandPolicy
+from aerostat_gym.params import load_params
+
+#: (scenario, wind speed, metric) of the printed key-cell columns.
+KEY_CELLS = (("recover", 10.0, "pendulum_zeta"), ("recover", 15.0, "pendulum_zeta"),
+             ("recover", 10.0, "pitch_zeta"), ("recover", 15.0, "pitch_zeta"),
+             ("recover", 15.0, "length_wander_m"), ("recover_small", 10.0, "return"))
+
+
+def report_result(label: str, policy, params) -> dict:
+    """One policy on the report suite, as a result :func:`protocol.aggregate` reads."""
+    out = {"label": label, "policy": label, "suite": "report", "scenarios": {}}
+    for sc, (speeds, seeds) in SUITES["report"].items():
+        ep = run_scenario(policy, sc, speeds, seeds,
+                          env_kwargs={"params": params, "obs_noise": SENSOR_NOISE})
+        out["scenarios"][sc] = {"episodes": [episode_metrics(ep, i)
+                                             for i in range(len(ep.speeds))]}
+    return out
+
+
+def key_cells(result: dict) -> list[float]:
+    row = []
+    for sc, u, metric in KEY_CELLS:
+        _, v = protocol.cell_values(result, sc, u, metric)
+        row.append(float(np.nanmean(v)))
+    return row
+
+
+def main(argv=None) -> list[dict]:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--policy", action="append", default=None, metavar="NAME_OR_PATH",
+                    help="a policy for load_policy (repeatable; default: shipped)")
+    ap.add_argument("--deadband", type=float, default=0.05,
+                    help="deadband as a fraction of the winch's top speed (default 0.05)")
+    ap.add_argument("--json", default=None, help="write the aggregate to this JSON file")
+    args = ap.parse_args(argv)
+    params = load_params()
+    names = ["passive", "modal", "modal_lqg"] + (args.policy or ["shipped"])
+    results = []
+    for name in names:
+        pol = load_policy(name, params=params, obs_noise=SENSOR_NOISE)
+        runs = [(name, pol)]
+        if name not in ("passive", "modal"):
+            runs.append((f"{name} deadband {args.deadband:g}", DeadbandPolicy(pol, args.deadband)))
+        for label, p in runs:
+            t0 = time.perf_counter()
+            results.append(report_result(label, p, params))
+            print(f"  {label}: {time.perf_counter() - t0:.0f} s", flush=True)
+    agg = protocol.aggregate(results)["aggregate"]
+    print("| policy | IQM [95% CI] | P(> passive) | P(> modal_lqg) | P(> modal) | "
+          + " | ".join(f"{m} {sc} {u:g}" for sc, u, m in KEY_CELLS) + " |")
+    for r in results:
+        row, p = agg[r["label"]], agg[r["label"]]["p_improvement"]
+        ps = [f"{p[o]['p']:.2f}" if o in p else "" for o in ("passive", "modal_lqg", "modal")]
+        print(f"| {r['label']} | {row['iqm']:.3f} [{row['iqm_ci'][0]:.3f}, {row['iqm_ci'][1]:.3f}]"
+              f" | {' | '.join(ps)} | " + " | ".join(f"{v:.3f}" for v in key_cells(r)) + " |")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(protocol.json_safe(agg), f, indent=1)
+    return results
+
+
+if __name__ == "__main__":
+    main()
