@@ -74,6 +74,7 @@ def main(argv=None) -> list[dict]:
     agg = protocol.aggregate(results)["aggregate"]
     print("| policy | IQM [95% CI] | P(> passive) | P(> modal_lqg) | P(> modal) | "
           + " | ".join(f"{m} {sc} {u:g}" for sc, u, m in KEY_CELLS) + " |")
+    print("|---" * (5 + len(KEY_CELLS)) + "|")
     for r in results:
         row, p = agg[r["label"]], agg[r["label"]]["p_improvement"]
         ps = [f"{p[o]['p']:.2f}" if o in p else "" for o in ("passive", "modal_lqg", "modal")]
