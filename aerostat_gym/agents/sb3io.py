@@ -113,8 +113,9 @@ class SB3Policy:
     newest last, zeros before the episode's first step: SB3's VecFrameStack on top of
     VecNormalize). ``residual`` = (base policy, scale[, deadband]) adds the model's action times
     scale to the base policy's (which reads the raw observation and keeps its own state), clipped
-    to [-1, 1] (:func:`combine_residual`). The state passed back and forth is then a dict of the recurrent model's state,
-    the stack and the base policy's state; ``episode_start`` resets all three.
+    to [-1, 1] (:func:`combine_residual`). The state passed back and forth is then a dict of
+    the recurrent model's state, the stack and the base policy's state; ``episode_start``
+    resets all three.
     """
 
     def __init__(self, model, vecnormalize=None, frame_stack: int = 1, residual=None):
