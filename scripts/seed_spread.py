@@ -11,7 +11,7 @@ per-seed and pooled aggregate tables to ``seeds.md`` and ``seeds.json``
         --policy runs/seeds/s1/ppo_final.zip ... --policy runs/seeds/s4/ppo_final.zip
     PYTHONPATH=. python scripts/seed_spread.py agents/baseline_report/report.json \\
         runs/seeds/eval/report.json --seeds ppo_tethered_aerostat s1/ppo_final ... s4/ppo_final \\
-        --label "shipped configuration" --out agents/ppo_training
+        --label "shipped configuration" [--names "seed 0" ... "seed 4"] --out agents/ppo_training
 """
 
 from __future__ import annotations
@@ -31,6 +31,8 @@ def main(argv=None) -> None:
                     help="report.json of evaluate runs on the report suite")
     ap.add_argument("--seeds", nargs="+", required=True,
                     help="labels (as in report.json) of the models, one per training seed")
+    ap.add_argument("--names", nargs="+", default=None,
+                    help="names to show for the models in the tables, one per --seeds label")
     ap.add_argument("--label", default="learned", help="name of the pooled configuration")
     ap.add_argument("--out", default="runs/seed_spread", help="directory for seeds.md/json")
     args = ap.parse_args(argv)
@@ -43,8 +45,13 @@ def main(argv=None) -> None:
     missing = [s for s in args.seeds if s not in results]
     if missing:
         raise SystemExit(f"not in {args.report_json}: {missing}; labels there: {list(results)}")
+    names = args.names or args.seeds
+    if len(names) != len(args.seeds):
+        raise SystemExit(f"--names gives {len(names)} names for {len(args.seeds)} --seeds")
     baselines = [results[b] for b in BASELINES if b in results]
-    spread = seed_spread(baselines, [results[s] for s in args.seeds], args.label)
+    spread = seed_spread(baselines, [{**results[s], "label": n}
+                                     for s, n in zip(args.seeds, names, strict=True)],
+                         args.label)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     md = seed_spread_markdown(spread)

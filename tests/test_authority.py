@@ -12,10 +12,12 @@ import pytest
 from aerostat_gym.agents.authority import (
     Design,
     authority_sweep,
+    design_result,
     gust_markdown,
     reachable,
     target_verdict,
 )
+from aerostat_gym.agents.evaluate import evaluate_policy
 from aerostat_gym.params import load_params
 
 PROTOCOL = Path(__file__).resolve().parents[1] / "agents" / "baseline_report" / "protocol.json"
@@ -60,3 +62,21 @@ def test_sweep_reproduces_the_report_suite():
     (rec10,) = [r for r in sweep["recover"] if r["wind_speed"] == 10.0]
     assert rec10["pendulum_zeta"] == pytest.approx(_stored("recover", 10.0, "modal",
                                                            "pendulum_zeta"), rel=1e-9)
+
+
+def test_design_result_is_the_evaluators_episode():
+    """A design's result on the report-tiny suite holds the same episodes as the evaluator's
+    run of the same controller (the default modal design is the ``modal`` baseline): returns
+    equal to 1e-12 relative, so the aggregate pools it with the baselines' results as their
+    peer; a suite without the report's sensor noise is refused."""
+    params = load_params()
+    mine = design_result(Design("modal", "modal"), params, "report-tiny")
+    ref = evaluate_policy("modal", "report-tiny", params=params)
+    assert set(mine["scenarios"]) == set(ref["scenarios"])
+    for sc, d in mine["scenarios"].items():
+        a = [(e["wind_speed"], e["seed"], e["return"]) for e in d["episodes"]]
+        b = [(e["wind_speed"], e["seed"], e["return"]) for e in ref["scenarios"][sc]["episodes"]]
+        assert [x[:2] for x in a] == [x[:2] for x in b]
+        assert [x[2] for x in a] == pytest.approx([x[2] for x in b], rel=1e-12)
+    with pytest.raises(ValueError, match="noisy suites"):
+        design_result(Design("modal", "modal"), params, "tiny")

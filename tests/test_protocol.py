@@ -3,6 +3,7 @@ protocol's paired verdicts and aggregate."""
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -85,15 +86,19 @@ def test_new_metrics_match_closed_forms():
 
 def test_report_suite_seeds_are_held_out():
     """Report seeds: 20 per cell, none used in training (SB3 seeds environment i with
-    --seed + i, default seed 0, for each shipped hyperparameter file), by another suite or by
-    the task-returns table; 16 m/s lies outside the training wind range; noise on."""
+    --seed + i, for training seeds 0-4 of each shipped hyperparameter file: the shipped policy's
+    seed and the seed-spread runs), by another suite or by the task-returns table; 16 m/s lies
+    outside the training wind range; noise on."""
     training = set()
     for path in list((ROOT / "agents" / "hyperparams").glob("*.yml")) + [
             ROOT / "agents" / "ppo_training" / "hyperparams.yml"]:
         for block in yaml.safe_load(path.read_text()).values():
             if isinstance(block, dict) and "n_envs" in block:
-                training |= set(range(0, int(block["n_envs"])))
-    assert training == set(range(32))  # ppo: 32 envs; sac, td3: 8
+                training |= {s + i for s in range(5) for i in range(int(block["n_envs"]))}
+    shipped_seed = json.loads((ROOT / "agents" / "ppo_training"
+                               / "training_summary.json").read_text())["seed"]
+    assert shipped_seed in range(5)
+    assert training == set(range(36))  # ppo: 32 envs; sac, td3: 8
     report = suite_seeds("report")
     assert report == set(range(5000, 5020))
     assert report & training == set()

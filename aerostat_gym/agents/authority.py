@@ -29,6 +29,8 @@ from .evaluate import (
     REPORT_RECOVER_SPEEDS,
     REPORT_SEEDS,
     SENSOR_NOISE,
+    SUITE_OBS_NOISE,
+    check_suite,
     episode_metrics,
     run_scenario,
 )
@@ -111,6 +113,22 @@ def _episodes(policy, scenario: str, speeds, seeds, params: Params) -> list[dict
     for r, reel in zip(rows, np.nanmax(np.abs(ep.reel_speed), axis=1), strict=True):
         r["peak_reel_speed_m_s"] = float(reel)
     return rows
+
+
+def design_result(design: Design, params: Params, suite: str = "report") -> dict:
+    """A design's episodes on every cell of a noisy suite, in the form of an evaluation result
+    (:func:`aerostat_gym.agents.evaluate.evaluate_policy`, without the histories), so that
+    :func:`aerostat_gym.agents.protocol.aggregate` pools it with the baselines' results on the
+    same suite: what the aggregate score and the probability of improvement reach with the
+    privileged full state."""
+    if SUITE_OBS_NOISE.get(suite) != SENSOR_NOISE:
+        raise ValueError(f"design_result runs the noisy suites (report, validation), got "
+                         f"{suite!r}")
+    pol = design.policy(params)
+    scenarios = {sc: {"episodes": _episodes(pol, sc, speeds, seeds, params)}
+                 for sc, (speeds, seeds) in check_suite(suite).items()}
+    return {"policy": design.label, "label": design.label, "suite": suite,
+            "obs_noise": SENSOR_NOISE, "scenarios": scenarios}
 
 
 def gust_rows(label: str, rows: list[dict], passive: list[dict], scenario: str,

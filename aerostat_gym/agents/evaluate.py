@@ -26,7 +26,10 @@ the README's baseline table) runs every scenario above at seeds 5000-5019 with t
 intervals mean something; ``report-tiny`` is a two-seed cut of it for tests. The report seeds
 are disjoint from the training seeds (the SB3 VecEnv seeds environment i of ``aerostat-gym
 train --seed S`` with S + i: 0-31 for the shipped policy), from the other suites (0, 100-109)
-and from the task-returns table (1000-1019).
+and from the task-returns table (1000-1019). ``validation`` runs the same scenarios with the
+same noise at other wind speeds (recover 7.5 and 12.5 m/s, gusty 6, 10 and 14 m/s) and seeds
+7000-7009: the suite on which a training seed or checkpoint is chosen
+(:mod:`aerostat_gym.agents.selection`), so the report suite stays unseen by the choice.
 
 The suite score is the mean episode return under the environment's default reward.
 """
@@ -108,6 +111,13 @@ REPORT_SEEDS = list(range(5000, 5020))
 REPORT_RECOVER_SPEEDS = [5.0, 10.0, 15.0]
 #: 16 m/s lies outside the training range DEFAULT_WIND_RANGE = (3, 15).
 REPORT_GUSTY_SPEEDS = [4.0, 8.0, 12.0, 16.0]
+#: The validation suite, for choosing among trained policies (training seeds, checkpoints)
+#: without looking at the report suite: the report's scenarios at wind speeds between the
+#: report's (inside the training range) and seeds disjoint from every other suite, so a policy
+#: chosen on it is then judged on cases its choice never saw.
+VALIDATION_SEEDS = list(range(7000, 7010))
+VALIDATION_RECOVER_SPEEDS = [7.5, 12.5]
+VALIDATION_GUSTY_SPEEDS = [6.0, 10.0, 14.0]
 RECOVER_SCENARIOS = [k for k, s in SCENARIOS.items() if s.free]
 GUSTY_SCENARIOS = [k for k, s in SCENARIOS.items() if not s.free]
 
@@ -119,11 +129,15 @@ SUITES = {
              "gusty": ([5.0, 10.0, 15.0], list(range(100, 110)))},
     "report": {**{k: (REPORT_RECOVER_SPEEDS, REPORT_SEEDS) for k in RECOVER_SCENARIOS},
                **{k: (REPORT_GUSTY_SPEEDS, REPORT_SEEDS) for k in GUSTY_SCENARIOS}},
+    "validation": {
+        **{k: (VALIDATION_RECOVER_SPEEDS, VALIDATION_SEEDS) for k in RECOVER_SCENARIOS},
+        **{k: (VALIDATION_GUSTY_SPEEDS, VALIDATION_SEEDS) for k in GUSTY_SCENARIOS}},
     "report-tiny": {"recover_cross_small": ([10.0], REPORT_SEEDS[:2]),
                     "gusty_severe": ([16.0], REPORT_SEEDS[:2])},
 }
 #: Sensor noise per suite (0 where absent).
-SUITE_OBS_NOISE = {"report": SENSOR_NOISE, "report-tiny": SENSOR_NOISE}
+SUITE_OBS_NOISE = {"report": SENSOR_NOISE, "report-tiny": SENSOR_NOISE,
+                   "validation": SENSOR_NOISE}
 
 
 def suite_seeds(name: str) -> set:

@@ -212,6 +212,8 @@ def scores(results: list[dict]) -> tuple[str, dict]:
     """(reference label, {label: (seeds, cells) score matrix}): return / |reference cell mean
     return| per episode (the reference is passive, else the first policy)."""
     labels = [r["label"] for r in results]
+    if len(set(labels)) != len(labels):
+        raise ValueError(f"policy labels must be distinct, got {labels}")
     ref = "passive" if "passive" in labels else labels[0]
     by = {r["label"]: r for r in results}
     cols = {lab: [] for lab in labels}

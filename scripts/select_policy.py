@@ -1,0 +1,67 @@
+"""Choose the policy to ship among trained candidates, on the validation suite.
+
+Reads the ``report.json`` of ``aerostat-gym evaluate --suite validation`` runs (the baselines
+and the candidates, in one or several runs) and writes the ranking of
+:func:`aerostat_gym.agents.selection.select` to ``selection.md`` and ``selection.json``.
+Usage::
+
+    aerostat-gym evaluate --suite validation --out runs/val/base --no-plots \\
+        --policy passive --policy tension --policy lqr --policy modal --policy lqg \\
+        --policy modal_lqg
+    aerostat-gym evaluate --suite validation --out runs/val/cand --no-plots \\
+        --policy runs/seeds/s0/ppo_final.zip ... --policy runs/seeds/s4/ppo_final.zip
+    PYTHONPATH=. python scripts/select_policy.py runs/val/base/report.json \\
+        runs/val/cand/report.json --candidates s0/ppo_final ... s4/ppo_final \\
+        [--rename "s0/ppo_final=seed 0" ...] --out agents/ppo_training
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from aerostat_gym.agents.policies import BASELINES
+from aerostat_gym.agents.protocol import dumps
+from aerostat_gym.agents.selection import select, selection_markdown
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("report_json", nargs="+", help="report.json of evaluate runs on the "
+                    "validation suite")
+    ap.add_argument("--candidates", nargs="+", required=True,
+                    help="labels (as in report.json) of the trained candidates")
+    ap.add_argument("--out", default="runs/selection", help="directory for selection.md/json")
+    ap.add_argument("--rename", action="append", default=[], metavar="LABEL=NAME",
+                    help="show candidate LABEL as NAME in the tables (repeatable)")
+    args = ap.parse_args(argv)
+    rename = dict(item.split("=", 1) for item in args.rename)
+    results = {}
+    for path in args.report_json:
+        for r in json.loads(Path(path).read_text()):
+            if r["label"] in results:
+                raise SystemExit(f"label {r['label']!r} appears twice in {args.report_json}")
+            results[r["label"]] = r
+    missing = [c for c in args.candidates if c not in results]
+    if missing:
+        raise SystemExit(f"not in {args.report_json}: {missing}; labels there: {list(results)}")
+    baselines = [results[b] for b in BASELINES if b in results]
+    sel = select([{**results[c], "label": rename.get(c, c)} for c in args.candidates],
+                 baselines)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    md = selection_markdown(sel)
+    (out / "selection.md").write_text(
+        "# Choosing the shipped policy on the validation suite\n\n"
+        "`PYTHONPATH=. python scripts/select_policy.py` (its docstring has the evaluate "
+        "commands) on the `validation` suite: the report's scenarios at recover 7.5 / 12.5 m/s "
+        "and gusty 6 / 10 / 14 m/s, seeds 7000-7009, sensor noise 0.01. The rule "
+        "(`aerostat_gym.agents.selection`): most issue-18 targets met on these cells, ties to "
+        f"the higher IQM.\n\nChosen: **{sel['chosen']}**.\n\n{md}")
+    (out / "selection.json").write_text(dumps(sel))
+    print(f"chosen: {sel['chosen']}\n\n{md}")
+
+
+if __name__ == "__main__":
+    main()
