@@ -23,6 +23,7 @@ from pathlib import Path
 from aerostat_gym.agents.authority import DESIGNS, design_result
 from aerostat_gym.agents.policies import BASELINES
 from aerostat_gym.agents.protocol import aggregate, json_safe
+from aerostat_gym.agents.report import load_results
 from aerostat_gym.params import load_params
 
 
@@ -50,8 +51,10 @@ def main(argv=None) -> dict:
     ap.add_argument("--episodes", default=None, help="JSON file caching the designs' episodes: "
                     "read if present, written after each design")
     args = ap.parse_args(argv)
-    found = {r["label"]: r for path in args.report_json
-             for r in json.loads(Path(path).read_text())}
+    try:
+        found = load_results(args.report_json)
+    except ValueError as err:
+        raise SystemExit(str(err)) from None
     baselines = [found[b] for b in BASELINES if b in found]
     if not baselines or {r["suite"] for r in baselines} != {"report"}:
         raise SystemExit(f"need the baselines' report-suite results; found {list(found)}")

@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from aerostat_gym.agents import protocol
-from aerostat_gym.agents.evaluate import SENSOR_NOISE, SUITES, episode_metrics, run_scenario
+from aerostat_gym.agents.evaluate import SENSOR_NOISE, suite_result
 from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.agents.residual import DeadbandPolicy
 from aerostat_gym.params import load_params
@@ -30,17 +30,6 @@ from aerostat_gym.params import load_params
 KEY_CELLS = (("recover", 10.0, "pendulum_zeta"), ("recover", 15.0, "pendulum_zeta"),
              ("recover", 10.0, "pitch_zeta"), ("recover", 15.0, "pitch_zeta"),
              ("recover", 15.0, "length_wander_m"), ("recover_small", 10.0, "return"))
-
-
-def report_result(label: str, policy, params) -> dict:
-    """One policy on the report suite, as a result :func:`protocol.aggregate` reads."""
-    out = {"label": label, "policy": label, "suite": "report", "scenarios": {}}
-    for sc, (speeds, seeds) in SUITES["report"].items():
-        ep = run_scenario(policy, sc, speeds, seeds,
-                          env_kwargs={"params": params, "obs_noise": SENSOR_NOISE})
-        out["scenarios"][sc] = {"episodes": [episode_metrics(ep, i)
-                                             for i in range(len(ep.speeds))]}
-    return out
 
 
 def key_cells(result: dict) -> list[float]:
@@ -69,7 +58,7 @@ def main(argv=None) -> list[dict]:
             runs.append((f"{name} deadband {args.deadband:g}", DeadbandPolicy(pol, args.deadband)))
         for label, p in runs:
             t0 = time.perf_counter()
-            results.append(report_result(label, p, params))
+            results.append(suite_result(p, label, "report", params))
             print(f"  {label}: {time.perf_counter() - t0:.0f} s", flush=True)
     agg = protocol.aggregate(results)["aggregate"]
     print("| policy | IQM [95% CI] | P(> passive) | P(> modal_lqg) | P(> modal) | "

@@ -17,11 +17,11 @@ per-seed and pooled aggregate tables to ``seeds.md`` and ``seeds.json``
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from aerostat_gym.agents.policies import BASELINES
 from aerostat_gym.agents.protocol import dumps
+from aerostat_gym.agents.report import load_results
 from aerostat_gym.agents.seed_spread import seed_spread, seed_spread_markdown
 
 
@@ -36,15 +36,10 @@ def main(argv=None) -> None:
     ap.add_argument("--label", default="learned", help="name of the pooled configuration")
     ap.add_argument("--out", default="runs/seed_spread", help="directory for seeds.md/json")
     args = ap.parse_args(argv)
-    results = {}
-    for path in args.report_json:
-        for r in json.loads(Path(path).read_text()):
-            if r["label"] in results:
-                raise SystemExit(f"label {r['label']!r} appears twice in {args.report_json}")
-            results[r["label"]] = r
-    missing = [s for s in args.seeds if s not in results]
-    if missing:
-        raise SystemExit(f"not in {args.report_json}: {missing}; labels there: {list(results)}")
+    try:
+        results = load_results(args.report_json, args.seeds)
+    except ValueError as err:
+        raise SystemExit(str(err)) from None
     names = args.names or args.seeds
     if len(names) != len(args.seeds):
         raise SystemExit(f"--names gives {len(names)} names for {len(args.seeds)} --seeds")

@@ -12,17 +12,17 @@ Usage::
         --policy runs/seeds/s0/ppo_final.zip ... --policy runs/seeds/s4/ppo_final.zip
     PYTHONPATH=. python scripts/select_policy.py runs/val/base/report.json \\
         runs/val/cand/report.json --candidates s0/ppo_final ... s4/ppo_final \\
-        [--rename "s0/ppo_final=seed 0" ...] --out agents/ppo_training
+        [--names "seed 0" ... "seed 4"] --out agents/ppo_training
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from aerostat_gym.agents.policies import BASELINES
 from aerostat_gym.agents.protocol import dumps
+from aerostat_gym.agents.report import load_results
 from aerostat_gym.agents.selection import select, selection_markdown
 
 
@@ -33,22 +33,20 @@ def main(argv=None) -> None:
     ap.add_argument("--candidates", nargs="+", required=True,
                     help="labels (as in report.json) of the trained candidates")
     ap.add_argument("--out", default="runs/selection", help="directory for selection.md/json")
-    ap.add_argument("--rename", action="append", default=[], metavar="LABEL=NAME",
-                    help="show candidate LABEL as NAME in the tables (repeatable)")
+    ap.add_argument("--names", nargs="+", default=None,
+                    help="names to show for the candidates in the tables, one per --candidates")
     args = ap.parse_args(argv)
-    rename = dict(item.split("=", 1) for item in args.rename)
-    results = {}
-    for path in args.report_json:
-        for r in json.loads(Path(path).read_text()):
-            if r["label"] in results:
-                raise SystemExit(f"label {r['label']!r} appears twice in {args.report_json}")
-            results[r["label"]] = r
-    missing = [c for c in args.candidates if c not in results]
-    if missing:
-        raise SystemExit(f"not in {args.report_json}: {missing}; labels there: {list(results)}")
+    names = args.names or args.candidates
+    if len(names) != len(args.candidates):
+        raise SystemExit(f"--names gives {len(names)} names for {len(args.candidates)} "
+                         "--candidates")
+    try:
+        results = load_results(args.report_json, args.candidates)
+    except ValueError as err:
+        raise SystemExit(str(err)) from None
     baselines = [results[b] for b in BASELINES if b in results]
-    sel = select([{**results[c], "label": rename.get(c, c)} for c in args.candidates],
-                 baselines)
+    sel = select([{**results[c], "label": n} for c, n in zip(args.candidates, names,
+                                                              strict=True)], baselines)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     md = selection_markdown(sel)

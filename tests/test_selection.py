@@ -2,11 +2,14 @@
 the rule's verdicts on constructed results whose answer is known in closed form, the tie-break
 on the aggregate, and the validation suite disjoint from the report suite."""
 
+import json
+
 import numpy as np
 import pytest
 
 from aerostat_gym.agents.evaluate import SUITES, suite_seeds
 from aerostat_gym.agents.protocol import aggregate
+from aerostat_gym.agents.report import load_results
 from aerostat_gym.agents.selection import (
     GUST_TARGETS,
     RECOVER_TARGETS,
@@ -116,3 +119,17 @@ def test_aggregate_refuses_a_label_twice():
     authority aggregate's designs "modal" and "lqr" share the baselines' names)."""
     with pytest.raises(ValueError, match="labels must be distinct"):
         aggregate([_result("passive", PASSIVE), _result("modal", MODAL), _result("modal", MODAL)])
+
+
+def test_load_results_names_what_is_wrong(tmp_path):
+    """Several runs' report.json read back as one {label: result}; a label twice or a wanted
+    label missing is an error naming it."""
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    a.write_text(json.dumps([_result("passive", PASSIVE)]))
+    b.write_text(json.dumps([_result("modal", MODAL)]))
+    got = load_results([a, b], ["modal"])
+    assert list(got) == ["passive", "modal"] and got["modal"]["suite"] == "validation"
+    with pytest.raises(ValueError, match="'passive' appears twice"):
+        load_results([a, a])
+    with pytest.raises(ValueError, match=r"\['lqg'\]; labels there: \['passive', 'modal'\]"):
+        load_results([a, b], ["lqg"])

@@ -30,9 +30,9 @@ from .evaluate import (
     REPORT_SEEDS,
     SENSOR_NOISE,
     SUITE_OBS_NOISE,
-    check_suite,
     episode_metrics,
     run_scenario,
+    suite_result,
 )
 from .lqr import LQRPolicy, LQRSchedule
 from .modal import ModalPolicy, ModalSchedule
@@ -116,19 +116,14 @@ def _episodes(policy, scenario: str, speeds, seeds, params: Params) -> list[dict
 
 
 def design_result(design: Design, params: Params, suite: str = "report") -> dict:
-    """A design's episodes on every cell of a noisy suite, in the form of an evaluation result
-    (:func:`aerostat_gym.agents.evaluate.evaluate_policy`, without the histories), so that
-    :func:`aerostat_gym.agents.protocol.aggregate` pools it with the baselines' results on the
-    same suite: what the aggregate score and the probability of improvement reach with the
+    """A design's episodes on every cell of a noisy suite (:func:`evaluate.suite_result`), so
+    that :func:`aerostat_gym.agents.protocol.aggregate` pools it with the baselines' results on
+    the same suite: what the aggregate score and the probability of improvement reach with the
     privileged full state."""
     if SUITE_OBS_NOISE.get(suite) != SENSOR_NOISE:
         raise ValueError(f"design_result runs the noisy suites (report, validation), got "
                          f"{suite!r}")
-    pol = design.policy(params)
-    scenarios = {sc: {"episodes": _episodes(pol, sc, speeds, seeds, params)}
-                 for sc, (speeds, seeds) in check_suite(suite).items()}
-    return {"policy": design.label, "label": design.label, "suite": suite,
-            "obs_noise": SENSOR_NOISE, "scenarios": scenarios}
+    return suite_result(design.policy(params), design.label, suite, params)
 
 
 def gust_rows(label: str, rows: list[dict], passive: list[dict], scenario: str,

@@ -25,8 +25,8 @@ the README's baseline table) runs every scenario above at seeds 5000-5019 with t
 :data:`SENSOR_NOISE` on (:data:`SUITE_OBS_NOISE`), so the seeds of a cell differ and their
 intervals mean something; ``report-tiny`` is a two-seed cut of it for tests. The report seeds
 are disjoint from the training seeds (the SB3 VecEnv seeds environment i of ``aerostat-gym
-train --seed S`` with S + i: 0-31 for the shipped policy), from the other suites (0, 100-109)
-and from the task-returns table (1000-1019). ``validation`` runs the same scenarios with the
+train --seed S`` with S + i: 1-32 for the shipped policy, 0-35 over training seeds 0-4), from
+the other suites (0, 100-109) and from the task-returns table (1000-1019). ``validation`` runs the same scenarios with the
 same noise at other wind speeds (recover 7.5 and 12.5 m/s, gusty 6, 10 and 14 m/s) and seeds
 7000-7009: the suite on which a training seed or checkpoint is chosen
 (:mod:`aerostat_gym.agents.selection`), so the report suite stays unseen by the choice.
@@ -105,7 +105,7 @@ SCENARIOS = {
 RECOVER = SCENARIOS["recover"].env_kwargs
 GUSTY = SCENARIOS["gusty"].env_kwargs
 
-#: Seeds of the report suite: disjoint from training (0-31 for the shipped policy), the other
+#: Seeds of the report suite: disjoint from training (1-32 for the shipped policy), the other
 #: suites (0, 100-109) and the task-returns table (1000-1019).
 REPORT_SEEDS = list(range(5000, 5020))
 REPORT_RECOVER_SPEEDS = [5.0, 10.0, 15.0]
@@ -317,6 +317,22 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
         returns.extend(ep.returns.tolist())
     out["score"] = float(np.mean(returns))
     return out
+
+
+def suite_result(policy, label: str, suite: str = "report", params=None) -> dict:
+    """A policy object's episodes on every cell of a suite, with the suite's sensor noise, as an
+    evaluation result without the histories (what :func:`aerostat_gym.agents.protocol.aggregate`
+    reads): for policies that have no name, such as a design of the authority sweep or a
+    baseline wrapped in a deadband."""
+    params = params if params is not None else load_params()
+    noise = SUITE_OBS_NOISE.get(suite, 0.0)
+    scenarios = {}
+    for scenario, (speeds, seeds) in check_suite(suite).items():
+        ep = run_scenario(policy, scenario, speeds, seeds,
+                          env_kwargs={"params": params, "obs_noise": noise})
+        scenarios[scenario] = {"episodes": [episode_metrics(ep, i) for i in range(len(ep.speeds))]}
+    return {"policy": label, "label": label, "suite": suite, "obs_noise": noise,
+            "scenarios": scenarios}
 
 
 def suite_score(policy, suite: str = "tiny", control_step: float = 0.2, params=None) -> float:

@@ -326,6 +326,23 @@ def run_evaluations(policies: list[str], suite: str, progress: bool = True,
     return results
 
 
+def load_results(paths, labels=()) -> dict:
+    """{label: result} from the ``report.json`` files of ``aerostat-gym evaluate`` runs (the
+    studies that pool several runs read them back this way). A label found twice, or one of
+    ``labels`` found nowhere, is a ValueError naming it."""
+    results = {}
+    for path in paths:
+        for r in json.loads(Path(path).read_text()):
+            if r["label"] in results:
+                raise ValueError(f"label {r['label']!r} appears twice in {list(map(str, paths))}")
+            results[r["label"]] = r
+    missing = [lab for lab in labels if lab not in results]
+    if missing:
+        raise ValueError(f"not in {list(map(str, paths))}: {missing}; labels there: "
+                         f"{list(results)}")
+    return results
+
+
 def policy_labels(policies: list[str]) -> list[str]:
     """The label of each policy in tables: a baseline's name, the shipped policy's file stem, a
     saved model's file stem, or (where two models share a stem, e.g. ``ppo_final.zip`` of two

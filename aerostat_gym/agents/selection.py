@@ -14,7 +14,8 @@ The rule, fixed before any candidate is evaluated:
    ``gusty``), each judged as issue 18 states it: ratios on the cell means, "above" and "not
    worse" on the paired 95 % interval over the seeds (:func:`protocol.paired_verdict`), "at most
    0.8 x" on the paired interval of candidate - 0.8 x passive
-   (:func:`authority.target_verdict`);
+   (:func:`authority.target_verdict`); the pendulum target's "at equal or lower peak reel
+   speed" needs the modal curve of the frontier runs and is left to them;
 2. the candidate meeting the most targets is chosen; a tie goes to the higher IQM of the
    aggregate score on the validation suite (the baselines are the other runs, as in
    :func:`protocol.aggregate`).
