@@ -10,6 +10,7 @@ import copy
 import math
 import pickle
 import warnings
+from dataclasses import replace
 
 import gymnasium as gym
 import numpy as np
@@ -255,3 +256,32 @@ def test_rendering_single_and_vector():
     venv.reset(seed=0)
     frame = venv.render()
     assert frame.shape == (480, 800, 3) and frame.dtype == np.uint8
+
+
+def test_trim_cache_is_bounded(monkeypatch):
+    """The process-wide trim cache keeps at most MAX_CACHED_TRIMS tables, evicting the oldest;
+    a table already cached is served without being rebuilt (the builder is stubbed: the bound,
+    not the trims, is under test)."""
+    from aerostat_gym.envs import episodes
+    from aerostat_gym.params import load_params
+
+    built = []
+
+    def fake_build(params, speeds):
+        built.append(params.tether.length)
+        return np.zeros((speeds.size, 3)), np.zeros(speeds.size)
+
+    monkeypatch.setattr(episodes, "_TRIMS", {})
+    monkeypatch.setattr(episodes, "_build_trims", fake_build)
+    monkeypatch.setattr(episodes, "MAX_CACHED_TRIMS", 3)
+    base = load_params()
+    lengths = [200.0, 250.0, 300.0, 350.0]
+    for length in lengths:
+        episodes.TrimTable(replace(base, tether=replace(base.tether, length=length)), 3.0, 15.0)
+    assert len(episodes._TRIMS) == 3 and built == lengths
+    # the newest three are served from the cache; the oldest (200 m) was evicted and is rebuilt
+    for length in lengths[1:]:
+        episodes.TrimTable(replace(base, tether=replace(base.tether, length=length)), 3.0, 15.0)
+    assert built == lengths
+    episodes.TrimTable(replace(base, tether=replace(base.tether, length=200.0)), 3.0, 15.0)
+    assert built == [*lengths, 200.0] and len(episodes._TRIMS) == 3

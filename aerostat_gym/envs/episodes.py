@@ -44,6 +44,9 @@ MAX_REDRAWS = 20
 
 # --- trims, shared between environments with the same parameters -------------------------------
 
+#: the most trim tables kept by the cache (one per parameter set and wind range; a process that
+#: walks through many parameter sets, such as a sweep, evicts the oldest first)
+MAX_CACHED_TRIMS = 16
 _TRIMS: dict = {}
 
 
@@ -57,6 +60,8 @@ class TrimTable:
                                * WIND_GRID, 10)
         key = (dumps_toml(params), float(self.speeds[0]), float(self.speeds[-1]))
         if key not in _TRIMS:
+            while len(_TRIMS) >= MAX_CACHED_TRIMS:
+                del _TRIMS[next(iter(_TRIMS))]  # dicts keep insertion order: the oldest
             _TRIMS[key] = _build_trims(params, self.speeds)
         self.states, self.tensions = _TRIMS[key]
 
