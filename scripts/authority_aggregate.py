@@ -9,8 +9,8 @@ asking it of a learned policy that reads noisy sensors. Usage::
     aerostat-gym evaluate --suite report --out runs/rep --no-plots --policy passive \\
         --policy tension --policy lqr --policy modal --policy lqg --policy modal_lqg
     PYTHONPATH=. python scripts/authority_aggregate.py runs/rep/report.json \\
-        --markdown docs/figures/authority_aggregate.md --json docs/figures/authority_aggregate.json \\
-        --episodes runs/authority_designs.json
+        --markdown docs/figures/authority_aggregate.md \\
+        --json docs/figures/authority_aggregate.json --episodes runs/authority_designs.json
 """
 
 from __future__ import annotations

@@ -26,10 +26,11 @@ the README's baseline table) runs every scenario above at seeds 5000-5019 with t
 intervals mean something; ``report-tiny`` is a two-seed cut of it for tests. The report seeds
 are disjoint from the training seeds (the SB3 VecEnv seeds environment i of ``aerostat-gym
 train --seed S`` with S + i: 1-32 for the shipped policy, 0-35 over training seeds 0-4), from
-the other suites (0, 100-109) and from the task-returns table (1000-1019). ``validation`` runs the same scenarios with the
-same noise at other wind speeds (recover 7.5 and 12.5 m/s, gusty 6, 10 and 14 m/s) and seeds
-7000-7009: the suite on which a training seed or checkpoint is chosen
-(:mod:`aerostat_gym.agents.selection`), so the report suite stays unseen by the choice.
+the other suites (0, 100-109) and from the task-returns table (1000-1019). ``validation``
+runs the same scenarios with the same noise at other wind speeds (recover 7.5 and 12.5 m/s,
+gusty 6, 10 and 14 m/s) and seeds 7000-7009: the suite on which a training seed or checkpoint
+is chosen (:mod:`aerostat_gym.agents.selection`), so the report suite stays unseen by the
+choice.
 
 The suite score is the mean episode return under the environment's default reward.
 """
@@ -288,6 +289,19 @@ def episode_metrics(ep: Episodes, i: int) -> dict:
     return m
 
 
+def suite_episodes(policy, suite: str, control_step: float = 0.2, params=None):
+    """(scenario, :class:`Episodes`) for every scenario of a suite, each run in one batch in
+    the environment of ``params`` (a Params; None: the baseline) with the suite's sensor
+    noise: the one loop behind :func:`evaluate_policy`, :func:`suite_result` and
+    :func:`suite_score`."""
+    kwargs = {"obs_noise": SUITE_OBS_NOISE.get(suite, 0.0)}
+    if params is not None:
+        kwargs["params"] = params
+    for scenario, (speeds, seeds) in check_suite(suite).items():
+        yield scenario, run_scenario(policy, scenario, speeds, seeds, control_step,
+                                     env_kwargs=kwargs)
+
+
 def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float = 0.2,
                     params=None) -> dict:
     """Metrics of one policy on a suite: {scenario: [per-episode metrics]}, plus the score.
@@ -298,7 +312,7 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
     noise (:data:`SUITE_OBS_NOISE`) is on in its environments and the LQG filter is designed
     for it.
     """
-    spec = check_suite(suite)
+    check_suite(suite)
     noise = SUITE_OBS_NOISE.get(suite, 0.0)
     params = params if params is not None and not isinstance(params, str) else load_params(params)
     policy = load_policy(policy_name, params=params, dt=control_step,
@@ -306,9 +320,7 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
     out = {"policy": policy_name, "suite": suite, "scenarios": {}, "obs_noise": noise,
            "tether_length_m": params.tether.length, "params_toml": dumps_toml(params)}
     returns = []
-    for scenario, (speeds, seeds) in spec.items():
-        ep = run_scenario(policy, scenario, speeds, seeds, control_step,
-                          env_kwargs={"params": params, "obs_noise": noise})
+    for scenario, ep in suite_episodes(policy, suite, control_step, params):
         rows = [episode_metrics(ep, i) for i in range(len(ep.speeds))]
         if hasattr(policy, "predicted_modes"):
             for r in rows:
@@ -324,25 +336,15 @@ def suite_result(policy, label: str, suite: str = "report", params=None) -> dict
     evaluation result without the histories (what :func:`aerostat_gym.agents.protocol.aggregate`
     reads): for policies that have no name, such as a design of the authority sweep or a
     baseline wrapped in a deadband."""
-    params = params if params is not None else load_params()
-    noise = SUITE_OBS_NOISE.get(suite, 0.0)
-    scenarios = {}
-    for scenario, (speeds, seeds) in check_suite(suite).items():
-        ep = run_scenario(policy, scenario, speeds, seeds,
-                          env_kwargs={"params": params, "obs_noise": noise})
-        scenarios[scenario] = {"episodes": [episode_metrics(ep, i) for i in range(len(ep.speeds))]}
-    return {"policy": label, "label": label, "suite": suite, "obs_noise": noise,
-            "scenarios": scenarios}
+    scenarios = {sc: {"episodes": [episode_metrics(ep, i) for i in range(len(ep.speeds))]}
+                 for sc, ep in suite_episodes(policy, suite, params=params)}
+    return {"policy": label, "label": label, "suite": suite,
+            "obs_noise": SUITE_OBS_NOISE.get(suite, 0.0), "scenarios": scenarios}
 
 
 def suite_score(policy, suite: str = "tiny", control_step: float = 0.2, params=None) -> float:
     """Mean episode return of a policy object on a suite (the training curve's measure), in
     the environment of ``params`` (default: the baseline) with the suite's sensor noise."""
-    returns = []
-    kwargs = {"obs_noise": SUITE_OBS_NOISE.get(suite, 0.0)}
-    if params is not None:
-        kwargs["params"] = params
-    for scenario, (speeds, seeds) in check_suite(suite).items():
-        returns.extend(run_scenario(policy, scenario, speeds, seeds, control_step,
-                                    env_kwargs=kwargs).returns)
+    returns = [r for _, ep in suite_episodes(policy, suite, control_step, params)
+               for r in ep.returns]
     return float(np.mean(returns))
