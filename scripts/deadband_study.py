@@ -1,13 +1,15 @@
-"""Deadband study: the report suite's aggregate and key cells for the braked winch, the modal
-controller, ``modal_lqg`` and given policies, each also with a command deadband added after the
-fact (:class:`aerostat_gym.agents.residual.DeadbandPolicy`), pooled by
+"""Command-path study: the report suite's aggregate and key cells for the braked winch, the
+modal controller, ``modal_lqg`` and given policies, each also with a command deadband and
+optionally a command low-pass added after the fact
+(:class:`aerostat_gym.agents.residual.ShapedPolicy`), pooled by
 :func:`aerostat_gym.agents.protocol.aggregate` (the episodes are those of ``aerostat-gym
 evaluate --suite report``).
 
 Usage::
 
     PYTHONPATH=. python scripts/deadband_study.py [--policy shipped] [--policy run/ppo_final.zip]
-        [--deadband 0.05] [--json out.json]
+        [--deadband 0.05] [--lowpass 1.0] [--shaped modal_lqg]
+        [--reference agents/baseline_report/report.json] [--json out.json]
 
 About 2.5 minutes per policy on one core.
 """
@@ -23,7 +25,8 @@ import numpy as np
 from aerostat_gym.agents import protocol
 from aerostat_gym.agents.evaluate import SENSOR_NOISE, suite_result
 from aerostat_gym.agents.policies import load_policy
-from aerostat_gym.agents.residual import DeadbandPolicy
+from aerostat_gym.agents.report import load_results, policy_labels
+from aerostat_gym.agents.residual import ShapedPolicy
 from aerostat_gym.params import load_params
 
 #: (scenario, wind speed, metric) of the printed key-cell columns.
@@ -46,16 +49,32 @@ def main(argv=None) -> list[dict]:
                     help="a policy for load_policy (repeatable; default: shipped)")
     ap.add_argument("--deadband", type=float, default=0.05,
                     help="deadband as a fraction of the winch's top speed (default 0.05)")
+    ap.add_argument("--lowpass", type=float, default=0.0,
+                    help="command low-pass time constant [s] (default 0: none)")
+    ap.add_argument("--shaped", action="append", default=None, metavar="NAME_OR_PATH",
+                    help="the policies also run with the deadband and low-pass (repeatable; "
+                         "default: every one but passive and modal)")
+    ap.add_argument("--reference", action="append", default=None, metavar="REPORT_JSON",
+                    help="read the unshaped policies' episodes from the report.json of an "
+                         "`aerostat-gym evaluate --suite report` run instead of running them")
     ap.add_argument("--json", default=None, help="write the aggregate to this JSON file")
     args = ap.parse_args(argv)
     params = load_params()
     names = ["passive", "modal", "modal_lqg"] + (args.policy or ["shipped"])
+    shaped = args.shaped or [n for n in names if n not in ("passive", "modal")]
+    stored = load_results(args.reference, policy_labels(names)) if args.reference else {}
     results = []
-    for name in names:
+    for name, stored_label in zip(names, policy_labels(names), strict=True):
+        if stored:
+            results.append({**stored[stored_label], "label": name})
+        if stored and name not in shaped:
+            continue
         pol = load_policy(name, params=params, obs_noise=SENSOR_NOISE)
-        runs = [(name, pol)]
-        if name not in ("passive", "modal"):
-            runs.append((f"{name} deadband {args.deadband:g}", DeadbandPolicy(pol, args.deadband)))
+        runs = [] if stored else [(name, pol)]
+        if name in shaped:
+            label = f"{name} deadband {args.deadband:g}" + (
+                f" low-pass {args.lowpass:g} s" if args.lowpass else "")
+            runs.append((label, ShapedPolicy(pol, args.deadband, args.lowpass)))
         for label, p in runs:
             t0 = time.perf_counter()
             results.append(suite_result(p, label, "report", params))

@@ -75,7 +75,8 @@ def test_shipped_policy_trained_on_its_registered_task():
     assert json.loads((run / "training_summary.json").read_text())["task"] == task_id
     assert json.loads((run / "version.json").read_text())["aerostat_gym"] == aerostat_gym.__version__
     assert project == {"eval_freq": 200000, "eval_suite": "damping",
-                       "residual": {"base": "modal_lqg", "scale": 0.1, "deadband": 0.03}}
+                       "residual": {"base": "modal_lqg", "scale": 0.1, "deadband": 0.03,
+                                    "lowpass": 1.0}}
 
 
 @pytest.mark.parametrize("value, expect", [

@@ -12,7 +12,7 @@ import yaml
 
 from aerostat_gym.agents.evaluate import run_scenario, suite_score
 from aerostat_gym.agents.policies import load_policy
-from aerostat_gym.agents.sb3io import PolicyError, SB3Policy, read_wrappers
+from aerostat_gym.agents.sb3io import CommandShaper, PolicyError, SB3Policy, read_wrappers
 from aerostat_gym.agents.train import (
     TrainingError,
     make_training_env,
@@ -142,14 +142,15 @@ def test_policy_frame_stack_matches_vecframestack():
     venv.close()
 
 
-@pytest.mark.parametrize("deadband", [0.0, 0.1])
-def test_residual_evaluation_matches_training_wrapper(deadband):
+@pytest.mark.parametrize("deadband, lowpass", [(0.0, 0.0), (0.1, 0.0), (0.1, 1.0)])
+def test_residual_evaluation_matches_training_wrapper(deadband, lowpass):
     """The action the residual wrapper sends the environment in training equals SB3Policy's
     residual action for the same policy output, across episode resets, with and without a
-    deadband (which, at 0.1 against residual commands of up to 0.3, zeroes some of them)."""
+    deadband (which, at 0.1 against residual commands of up to 0.3, zeroes some of them) and a
+    command low-pass (whose state both must reset at each episode start)."""
     env_kwargs = {**SMOKE_ENV, "max_episode_steps": 7}
-    spec = wrapper_spec({"residual": {"base": "lqg", "scale": 0.3, "deadband": deadband}},
-                        env_kwargs)
+    spec = wrapper_spec({"residual": {"base": "lqg", "scale": 0.3, "deadband": deadband,
+                                      "lowpass": lowpass}}, env_kwargs)
     base = residual_base(spec, env_kwargs)
     venv = make_training_env(2, 0, env_kwargs, None, spec, base)
     inner = venv.venv
@@ -167,7 +168,8 @@ def test_residual_evaluation_matches_training_wrapper(deadband):
 
     model = Model()
     policy = SB3Policy(model, None,
-                       residual=(load_policy("lqg", obs_noise=0.01), 0.3, deadband))
+                       residual=(load_policy("lqg", obs_noise=0.01),
+                                 CommandShaper(0.3, deadband, lowpass, 0.2)))
     state, start, rng, ends = None, np.ones(2, bool), np.random.default_rng(1), 0
     for _ in range(20):
         model.action = rng.uniform(-1.5, 1.5, (2, 1)).astype(np.float32)
@@ -182,9 +184,10 @@ def test_residual_evaluation_matches_training_wrapper(deadband):
 
 
 def test_residual_deadband_closed_form():
-    """combine_residual: clip(base + scale clip(policy)) with every |command| below the
-    deadband exactly zero (the brake's command); the deadband is validated at the door."""
-    from aerostat_gym.agents.residual import DeadbandPolicy, check_residual
+    """The command path without a low-pass: clip(base + scale clip(policy)) with every |command|
+    below the deadband exactly zero (the brake's command); the deadband is validated at the
+    door."""
+    from aerostat_gym.agents.residual import ShapedPolicy, check_residual
     from aerostat_gym.agents.sb3io import combine_residual
 
     class Constant:
@@ -194,9 +197,10 @@ def test_residual_deadband_closed_form():
         def predict(self, obs, state=None, episode_start=None, deterministic=True):
             return self.action, state
 
-    out = combine_residual([0.02, -0.02, 0.5, 0.9], [0.05, 0.6, -2.0, 1.0], 0.1, 0.03)
+    out, _ = CommandShaper(0.1, deadband=0.03)([0.02, -0.02, 0.5, 0.9], [0.05, 0.6, -2.0, 1.0])
     np.testing.assert_allclose(out[:, 0], [0.0, 0.04, 0.4, 1.0], atol=1e-7)
-    np.testing.assert_array_equal(DeadbandPolicy(Constant([[0.02], [-0.5]]), 0.03).predict(
+    np.testing.assert_allclose(combine_residual([0.02, 0.9], [0.05, 1.0], 0.1), [0.025, 1.0])
+    np.testing.assert_array_equal(ShapedPolicy(Constant([[0.02], [-0.5]]), 0.03).predict(
         np.zeros((2, N_OBS)))[0], np.array([[0.0], [-0.5]], np.float32))
     assert check_residual({"base": "modal_lqg", "scale": 0.1, "deadband": 0.03}) == {
         "base": "modal_lqg", "scale": 0.1, "deadband": 0.03}
@@ -204,6 +208,44 @@ def test_residual_deadband_closed_form():
     for bad in (-0.1, 1.0, float("nan"), True, "0.1"):
         with pytest.raises(PolicyError, match="deadband"):
             check_residual({"base": "modal_lqg", "deadband": bad})
+
+
+def test_command_lowpass_closed_form():
+    """CommandShaper's low-pass: a step u held from an episode start gives the sampled
+    first-order step response y_k = u (1 - exp(-k dt / tau)) exactly (zero-order hold); the
+    deadband acts on the filtered command; an episode start resets the filter to rest; the time
+    constant is validated at the door."""
+    from aerostat_gym.agents.residual import ShapedPolicy, check_residual
+
+    tau, dt, u = 1.0, 0.2, 0.5
+    exact = u * (1.0 - np.exp(-np.arange(1, 8) * dt / tau))  # y_1 ... y_7
+    shaper = CommandShaper(0.1, deadband=0.2, lowpass=tau, dt=dt)
+    y, out = None, []
+    for k in range(6):
+        cmd, y = shaper([u, u], [0.0, 0.0], y, np.array([k == 0, False]))
+        out.append(cmd[:, 0].astype(np.float64))
+    got = np.array(out)
+    np.testing.assert_array_equal(got[:, 0], got[:, 1])  # no state yet = at rest
+    big = exact[:6] >= 0.2
+    np.testing.assert_allclose(got[big, 0], exact[:6][big], rtol=1e-6)
+    assert np.all(got[~big] == 0.0)  # under the deadband: the brake
+    _, y = shaper([u, u], [0.0, 0.0], y, np.array([True, False]))
+    np.testing.assert_allclose(y, [exact[0], exact[6]], rtol=1e-12)  # env 0 restarts
+    assert CommandShaper(0.1, lowpass=0.0).alpha == 1.0
+
+    class Step:
+        def predict(self, obs, state=None, episode_start=None, deterministic=True):
+            return np.full((1, 1), u, np.float32), state
+
+    policy, state = ShapedPolicy(Step(), lowpass=tau, dt=dt), None
+    for k in range(3):
+        a, state = policy.predict(np.zeros((1, N_OBS)), state=state,
+                                  episode_start=np.array([k == 0]))
+    assert a[0, 0] == pytest.approx(exact[2], rel=1e-6)
+    assert check_residual({"base": "modal_lqg", "scale": 0.1, "lowpass": 1})["lowpass"] == 1.0
+    for bad in (-0.5, 4.5, float("inf"), True, "1"):
+        with pytest.raises(PolicyError, match="lowpass"):
+            check_residual({"base": "modal_lqg", "lowpass": bad})
 
 
 @pytest.mark.parametrize("base", ["modal", "lqr"])

@@ -51,8 +51,8 @@ from .policies import load_policy
 from .sb3io import PolicyError
 
 #: Sensor noise of the report suites (std in the observation's scaled units, on every standard
-#: channel): the level the LQG baseline is designed for and evaluated at in the README and
-#: scripts/baseline_table.py. It reaches the policies that read the standard channels
+#: channel): the level the LQG baseline is designed for and evaluated at in the README's
+#: tables. It reaches the policies that read the standard channels
 #: (passive ignores them; tension feedback, LQG and learned policies do); the privileged LQR
 #: and modal controllers read the appended full state, which carries no noise.
 SENSOR_NOISE = 0.01

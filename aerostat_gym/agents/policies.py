@@ -128,8 +128,8 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     if name == "modal_lqg":
         return LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal")
     if name in SHIPPED:
-        return load_sb3(shipped_path(SHIPPED[name]), base_factory)
+        return load_sb3(shipped_path(SHIPPED[name]), base_factory, dt)
     if name.endswith(".zip") or Path(name).exists():
-        return load_sb3(name, base_factory)
+        return load_sb3(name, base_factory, dt)
     raise PolicyError(f"unknown policy {name!r}: use one of {BASELINES + tuple(SHIPPED)} or a "
                       "path to a .zip")

@@ -11,9 +11,12 @@ forms (``lqg``, ``modal_lqg``: the same gains on a Kalman filter's estimate) are
   training; it sits on the raw environment (below VecNormalize), so the base policy reads the
   observation the environment gives, and it resets the base policy's state at every episode
   start (the batch resets an environment in the same step its episode ends).
-- :func:`aerostat_gym.agents.sb3io.combine_residual`: the combination, shared by training and
-  :class:`aerostat_gym.agents.sb3io.SB3Policy` at evaluation; an optional ``deadband`` (a
-  fraction of the winch's top speed) zeroes, and so brakes, every smaller command.
+- :class:`aerostat_gym.agents.sb3io.CommandShaper`: the command path, shared by training and
+  :class:`aerostat_gym.agents.sb3io.SB3Policy` at evaluation; an optional ``lowpass`` (a time
+  constant [s]) filters the summed command, an optional ``deadband`` (a fraction of the winch's
+  top speed) then zeroes, and so brakes, every smaller command.
+- :class:`ShapedPolicy`: the same low-pass and deadband put on any policy after the fact, for
+  the studies that ask what they buy without learning.
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ import math
 import numpy as np
 
 from ..envs.spaces import N_OBS
-from .sb3io import PolicyError, apply_deadband, combine_residual
+from .sb3io import CommandShaper, PolicyError
 
 #: Baselines that read the standard observation only, allowed as residual bases.
 RESIDUAL_BASES = ("lqg", "modal_lqg", "tension")
@@ -31,13 +34,18 @@ RESIDUAL_BASES = ("lqg", "modal_lqg", "tension")
 PRIVILEGED_BASES = ("lqr", "modal")
 
 
+#: Longest command low-pass time constant accepted [s]: about a tenth of the baseline's fastest
+#: pendulum period (36 s at 15 m/s); longer filters lag the swing they are to damp.
+MAX_LOWPASS = 4.0
+
+
 def check_residual(spec) -> dict:
-    """The residual block {base, scale[, deadband]} validated (a clear PolicyError otherwise);
-    the deadband is returned only when it is set."""
-    if not isinstance(spec, dict) or set(spec) - {"base", "scale", "deadband"} \
+    """The residual block {base, scale[, deadband][, lowpass]} validated (a clear PolicyError
+    otherwise); the deadband and the low-pass are returned only when they are set."""
+    if not isinstance(spec, dict) or set(spec) - {"base", "scale", "deadband", "lowpass"} \
             or "base" not in spec:
-        raise PolicyError("residual must be a mapping {base: NAME, scale: S[, deadband: D]}, "
-                          f"got {spec!r}")
+        raise PolicyError("residual must be a mapping {base: NAME, scale: S[, deadband: D]"
+                          f"[, lowpass: TAU]}}, got {spec!r}")
     base = spec["base"]
     if base in PRIVILEGED_BASES:
         raise PolicyError(f"residual base {base!r} reads the privileged full state: learned and "
@@ -52,7 +60,23 @@ def check_residual(spec) -> dict:
     out = {"base": base, "scale": float(scale)}
     if "deadband" in spec:
         out["deadband"] = check_deadband(spec["deadband"])
+    if "lowpass" in spec:
+        out["lowpass"] = check_lowpass(spec["lowpass"])
     return out
+
+
+def check_lowpass(tau) -> float:
+    """A command low-pass time constant [s] in [0, MAX_LOWPASS] (0: no filter)."""
+    if isinstance(tau, bool) or not isinstance(tau, (int, float)) or not math.isfinite(tau) \
+            or not 0 <= tau <= MAX_LOWPASS:
+        raise PolicyError(f"residual lowpass is a time constant in [0, {MAX_LOWPASS:g}] s, "
+                          f"got {tau!r}")
+    return float(tau)
+
+
+def residual_shaper(spec: dict, dt: float) -> CommandShaper:
+    """The command path of a validated residual block at control step ``dt`` [s]."""
+    return CommandShaper(spec["scale"], spec.get("deadband", 0.0), spec.get("lowpass", 0.0), dt)
 
 
 def check_deadband(d) -> float:
@@ -64,29 +88,31 @@ def check_deadband(d) -> float:
     return float(d)
 
 
-def residual_vec_env(venv, base, scale: float, deadband: float = 0.0):
+def residual_vec_env(venv, base, shaper: CommandShaper):
     """``venv`` (a raw SB3 VecEnv giving the standard observation first) with the actions
-    made residual on ``base`` (a policy with the SB3 ``predict`` signature)."""
+    made residual on ``base`` (a policy with the SB3 ``predict`` signature) through ``shaper``."""
     from stable_baselines3.common.vec_env import VecEnvWrapper
 
     class ResidualVecEnv(VecEnvWrapper):
-        """Adds the base policy's action: env action = clip(base + scale * action, -1, 1)."""
+        """Adds the base policy's action: env action = shaper(base, action)."""
 
         def __init__(self):
             super().__init__(venv)
-            self.base, self.scale, self.deadband = base, float(scale), float(deadband)
-            self._obs, self._state = None, None
+            self.base, self.shaper = base, shaper
+            self._obs, self._state, self._filter = None, None, None
             self._start = np.ones(self.num_envs, bool)
 
         def reset(self):
             self._obs = self.venv.reset()
-            self._state, self._start = None, np.ones(self.num_envs, bool)
+            self._state, self._filter = None, None
+            self._start = np.ones(self.num_envs, bool)
             return self._obs
 
         def step_async(self, actions):
             b, self._state = self.base.predict(self._obs[:, :N_OBS], state=self._state,
                                                episode_start=self._start, deterministic=True)
-            self.venv.step_async(combine_residual(b, actions, self.scale, self.deadband))
+            cmd, self._filter = self.shaper(b, actions, self._filter, self._start)
+            self.venv.step_async(cmd)
 
         def step_wait(self):
             obs, rew, dones, infos = self.venv.step_wait()
@@ -96,17 +122,24 @@ def residual_vec_env(venv, base, scale: float, deadband: float = 0.0):
     return ResidualVecEnv()
 
 
-class DeadbandPolicy:
-    """Any policy with its commands below ``deadband`` (a fraction of the winch's top speed) set
-    to zero, which brakes the drum: the deadband of the residual block applied after the fact,
-    to a baseline or a trained model, for studies of what it buys (``scripts/deadband_study.py``).
-    """
+class ShapedPolicy:
+    """Any policy with the residual's low-pass (time constant ``lowpass`` [s] at control step
+    ``dt``) and ``deadband`` (a fraction of the winch's top speed; smaller commands brake) put on
+    its commands after the fact: :class:`CommandShaper` with a zero residual. For the studies
+    of what the command path buys without learning (``scripts/deadband_study.py``)."""
 
-    def __init__(self, policy, deadband: float):
-        self.policy, self.deadband = policy, check_deadband(deadband)
+    def __init__(self, policy, deadband: float = 0.0, lowpass: float = 0.0, dt: float = 0.2):
+        self.policy = policy
+        self.shaper = CommandShaper(1.0, check_deadband(deadband), check_lowpass(lowpass), dt)
         self.obs_dim = getattr(policy, "obs_dim", None)
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
-        a, state = self.policy.predict(observation, state=state, episode_start=episode_start,
-                                       deterministic=deterministic)
-        return apply_deadband(a, self.deadband), state
+        state = state if isinstance(state, dict) else {}
+        a, inner = self.policy.predict(observation, state=state.get("inner"),
+                                       episode_start=episode_start, deterministic=deterministic)
+        a = np.asarray(a, np.float64).reshape(-1)
+        start = None if episode_start is None else np.broadcast_to(
+            np.asarray(episode_start, bool).reshape(-1), a.shape)
+        cmd, filtered = self.shaper(a, np.zeros_like(a), state.get("filter"), start)
+        return (cmd[0] if np.ndim(observation) == 1 else cmd), {"inner": inner,
+                                                                "filter": filtered}

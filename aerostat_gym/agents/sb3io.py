@@ -5,7 +5,8 @@ baseline.
 A model trained with wrappers beyond VecNormalize (``frame_stack``, ``residual``: see
 :mod:`aerostat_gym.agents.train`) is saved with ``<stem>_wrappers.json`` beside it
 (:func:`wrappers_path`), ``{"frame_stack": K, "residual": {"base": ..., "scale": ...,
-"obs_noise": ...}}``, so that loading it rebuilds the same observation stack and base policy.
+"obs_noise": ...[, "deadband": ..., "lowpass": ...]}}``, so that loading it rebuilds the same
+observation stack, base policy and command path.
 
 Stable-Baselines3 (and sb3-contrib, for RecurrentPPO) are optional dependencies (the ``train``
 extra): they are imported inside the functions that need them.
@@ -14,6 +15,7 @@ extra): they are imported inside the functions that need them.
 from __future__ import annotations
 
 import json
+import math
 import pickle
 import warnings
 import zipfile
@@ -111,11 +113,11 @@ class SB3Policy:
 
     ``frame_stack`` K > 1 stacks the last K normalised observations (oldest first, the
     newest last, zeros before the episode's first step: SB3's VecFrameStack on top of
-    VecNormalize). ``residual`` = (base policy, scale[, deadband]) adds the model's action times
-    scale to the base policy's (which reads the raw observation and keeps its own state), clipped
-    to [-1, 1] (:func:`combine_residual`). The state passed back and forth is then a dict of
-    the recurrent model's state, the stack and the base policy's state; ``episode_start``
-    resets all three.
+    VecNormalize). ``residual`` = (base policy, :class:`CommandShaper`) adds the model's action
+    times the shaper's scale to the base policy's (which reads the raw observation and keeps its
+    own state), clipped to [-1, 1], low-passed and deadbanded as in training. The state passed
+    back and forth is then a dict of the recurrent model's state, the stack, the base policy's
+    state and the command filter's; ``episode_start`` resets all four.
     """
 
     def __init__(self, model, vecnormalize=None, frame_stack: int = 1, residual=None):
@@ -160,22 +162,64 @@ class SB3Policy:
             a, _ = self.model.predict(obs, deterministic=deterministic)
         a = np.asarray(a, np.float64).reshape(-1)
         if self.residual is not None:
-            base, scale, *rest = self.residual
+            base, shaper = self.residual
             b, state["base"] = base.predict(raw, state=state.get("base"), episode_start=start,
                                             deterministic=True)
-            a = combine_residual(b, a, scale, *rest)[:, 0]
+            a, state["filter"] = shaper(b, a, state.get("filter"), start)
+            a = a[:, 0]
         return to_actions(a, single), state
 
 
-def combine_residual(base_action, policy_action, scale: float,
-                     deadband: float = 0.0) -> np.ndarray:
-    """clip(base + scale * clip(policy, -1, 1), -1, 1) as float32, shape (N, 1), with every
-    command smaller in magnitude than ``deadband`` (a fraction of the winch's top speed) set
-    to exactly zero, which applies the brake: the residual's sum of a small base command and
-    sensor noise then holds the drum instead of reeling on noise."""
+def combine_residual(base_action, policy_action, scale: float) -> np.ndarray:
+    """clip(base + scale * clip(policy, -1, 1), -1, 1), shape (N,): the residual's sum, before
+    the command path's low-pass and deadband (:class:`CommandShaper`)."""
     b = np.asarray(base_action, np.float64).reshape(-1)
     a = np.clip(np.asarray(policy_action, np.float64).reshape(-1), -1.0, 1.0)
-    return apply_deadband(np.clip(b + scale * a, -1.0, 1.0), deadband)[:, None]
+    return np.clip(b + scale * a, -1.0, 1.0)
+
+
+def lowpass_gain(time_constant: float, dt: float) -> float:
+    """alpha of the first-order low-pass y <- y + alpha (u - y) that holds u over each control
+    step dt: the exact zero-order-hold discretisation of tau dy/dt = u - y, alpha =
+    1 - exp(-dt / tau); 1 (no filter) for tau = 0."""
+    return 1.0 if time_constant == 0 else 1.0 - math.exp(-dt / time_constant)
+
+
+class CommandShaper:
+    """The residual's command path, one object for training (the residual VecEnv wrapper) and
+    evaluation (:class:`SB3Policy`): c = clip(base + scale clip(policy, -1, 1), -1, 1)
+    (:func:`combine_residual`), then a first-order low-pass of time constant ``lowpass`` [s]
+    (:func:`lowpass_gain`), then the ``deadband``.
+
+    The low-pass keeps the winch set-point from stepping every control step on sensor noise and
+    on the residual's own chatter: with tau = 1 s it passes the 36-45 s pendulum (baseline
+    aerostat, 5-15 m/s) with a phase lag of 8-10 degrees and attenuates the 2-3.7 s pitching and
+    axial-spring bands 2-3.2 times (|1 + i omega tau|). The deadband (a fraction of the winch's top speed) sets every smaller command to exactly
+    zero, which applies the brake: the sum of a small base command and sensor noise then holds
+    the drum instead of reeling on noise. It acts on the filtered command, so a command that
+    has decayed under it brakes. The filter state starts at 0 (the drum at rest) at every
+    episode start.
+    """
+
+    def __init__(self, scale: float, deadband: float = 0.0, lowpass: float = 0.0,
+                 dt: float = 0.2):
+        self.scale, self.deadband = float(scale), float(deadband)
+        self.lowpass, self.dt = float(lowpass), float(dt)
+        self.alpha = lowpass_gain(self.lowpass, self.dt)
+
+    def __call__(self, base_action, policy_action, filtered=None, start=None):
+        """(command (N, 1) float32, filter state (N,)) for one step of N environments;
+        ``filtered`` is the previous step's state (None: every environment starts), ``start``
+        (N,) bool the environments whose episode starts at this step."""
+        c = combine_residual(base_action, policy_action, self.scale)
+        if self.alpha == 1.0:  # no filter: the sum itself, bit for bit
+            y = c
+        else:
+            y = np.zeros_like(c) if filtered is None else np.array(filtered, np.float64)
+            if start is not None:
+                y[np.asarray(start, bool).reshape(-1)] = 0.0
+            y = y + self.alpha * (c - y)
+        return apply_deadband(y, self.deadband)[:, None], y
 
 
 def apply_deadband(action, deadband: float) -> np.ndarray:
@@ -210,10 +254,11 @@ def read_wrappers(path: str | Path) -> dict:
         raise PolicyError(f"cannot read the wrapper metadata {meta}: {exc}") from None
 
 
-def load_sb3(path: str | Path, base_factory=None) -> SB3Policy:
+def load_sb3(path: str | Path, base_factory=None, dt: float = 0.2) -> SB3Policy:
     """Load a saved model (+ its ``_vecnormalize.pkl`` and ``_wrappers.json``); clear errors
     for a missing or corrupt file. ``base_factory(name, obs_noise)`` builds the base policy of
-    a residual model (required for one)."""
+    a residual model (required for one); ``dt`` [s] is the control step its command filter
+    runs at."""
     path = Path(path)
     if not path.is_file():
         raise PolicyError(f"policy file not found: {path}")
@@ -255,5 +300,6 @@ def load_sb3(path: str | Path, base_factory=None) -> SB3Policy:
             raise PolicyError(f"{path} is a residual policy on {spec.get('base')!r}: load it "
                               "with load_policy, which builds the base policy")
         residual = (base_factory(spec["base"], float(spec.get("obs_noise", 0.0))),
-                    float(spec["scale"]), float(spec.get("deadband", 0.0)))
+                    CommandShaper(spec["scale"], spec.get("deadband", 0.0),
+                                  spec.get("lowpass", 0.0), dt))
     return SB3Policy(model, norm, frame_stack=k, residual=residual)

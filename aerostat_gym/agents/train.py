@@ -58,7 +58,7 @@ from ..resources import shipped_path
 from .evaluate import check_suite, suite_score
 from .policies import load_policy
 from .report import plot_training_curve
-from .residual import check_residual, residual_vec_env
+from .residual import check_residual, residual_shaper, residual_vec_env
 from .sb3io import (
     FOLDER_WRAPPERS,
     PolicyError,
@@ -182,7 +182,8 @@ def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict 
     venv = VecMonitor(sb3_vec_env(n_envs, seed=seed, **env_kwargs))
     if wrappers.get("residual"):
         res = wrappers["residual"]
-        venv = residual_vec_env(venv, base, res["scale"], res.get("deadband", 0.0))
+        venv = residual_vec_env(venv, base,
+                                residual_shaper(res, float(env_kwargs.get("control_step", 0.2))))
     if normalize is not None:
         if stats is not None and Path(stats).is_file():
             venv = VecNormalize.load(str(stats), venv)
@@ -193,12 +194,13 @@ def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict 
     return venv
 
 
-def run_policy(model, wrappers: dict, base=None) -> SB3Policy:
-    """The model as a policy object with the same observation pipeline as in training."""
+def run_policy(model, wrappers: dict, base=None, dt: float = 0.2) -> SB3Policy:
+    """The model as a policy object with the same observation pipeline and command path as in
+    training, at control step ``dt`` [s] (the evaluation suites')."""
     res = wrappers.get("residual")
     return SB3Policy(model, find_vecnormalize(model.get_env()),
                      frame_stack=wrappers.get("frame_stack", 1),
-                     residual=(base, res["scale"], res.get("deadband", 0.0)) if res else None)
+                     residual=(base, residual_shaper(res, dt)) if res else None)
 
 
 def _count(name: str, value) -> int:
