@@ -259,7 +259,9 @@ def test_residual_refuses_privileged_bases(base):
 
 
 def test_residual_model_needs_its_base(tmp_path):
-    """A residual model's metadata is honoured by load_policy and required by load_sb3."""
+    """A residual model's metadata is honoured by load_policy and required by load_sb3; a
+    corrupt residual block (privileged base, bad low-pass, deadband or sensor noise) is refused
+    at the door with the key named."""
     from aerostat_gym.agents.sb3io import load_sb3
 
     algo, config = _config(tmp_path, "residual-ppo")
@@ -268,9 +270,13 @@ def test_residual_model_needs_its_base(tmp_path):
     with pytest.raises(PolicyError, match="residual policy on 'lqg'"):
         load_sb3(run / "ppo_final.zip")
     meta = run / "ppo_final_wrappers.json"
-    meta.write_text(json.dumps({"residual": {"base": "modal", "scale": 0.3}}))
-    with pytest.raises(PolicyError, match="privileged"):
-        load_policy(str(run / "ppo_final.zip"))
+    for block, match in (({"base": "modal", "scale": 0.3}, "privileged"),
+                         ({"base": "lqg", "scale": 0.3, "lowpass": -1.0}, "lowpass"),
+                         ({"base": "lqg", "scale": 0.3, "deadband": 2.0}, "deadband"),
+                         ({"base": "lqg", "scale": 0.3, "obs_noise": "high"}, "obs_noise")):
+        meta.write_text(json.dumps({"residual": block}))
+        with pytest.raises(PolicyError, match=match):
+            load_policy(str(run / "ppo_final.zip"))
 
 
 def test_normalisation_floor_on_a_channel_constant_in_training():

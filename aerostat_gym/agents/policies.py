@@ -17,6 +17,7 @@ deterministic)`` signature, so one evaluator runs baselines and trained models a
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +29,7 @@ from ..resources import SHIPPED_POLICY, shipped_path
 from .lqg import LQGPolicy
 from .lqr import LQRPolicy
 from .modal import ModalPolicy
-from .residual import check_residual
+from .residual import check_residual, residual_shaper
 from .sb3io import PolicyError, as_batch, load_sb3, to_actions
 
 BASELINES = ("passive", "tension", "lqr", "modal", "lqg", "modal_lqg")
@@ -111,9 +112,17 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     """
     params = params or load_params()
 
-    def base_factory(base: str, noise: float):
-        check_residual({"base": base})
-        return load_policy(base, params=params, dt=dt, wind_range=wind_range, obs_noise=noise)
+    def residual_factory(spec: dict):
+        """A saved residual block validated at the door, as (base policy, command path)."""
+        res = check_residual({k: v for k, v in spec.items() if k != "obs_noise"})
+        noise = spec.get("obs_noise", 0.0)
+        if isinstance(noise, bool) or not isinstance(noise, (int, float)) \
+                or not (math.isfinite(noise) and noise >= 0):
+            raise PolicyError(f"the residual block's obs_noise must be a finite number >= 0, "
+                              f"got {noise!r}")
+        base = load_policy(res["base"], params=params, dt=dt, wind_range=wind_range,
+                           obs_noise=float(noise))
+        return base, residual_shaper(res, dt)
 
     if name == "passive":
         return PassivePolicy()
@@ -128,8 +137,8 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     if name == "modal_lqg":
         return LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal")
     if name in SHIPPED:
-        return load_sb3(shipped_path(SHIPPED[name]), base_factory, dt)
+        return load_sb3(shipped_path(SHIPPED[name]), residual_factory)
     if name.endswith(".zip") or Path(name).exists():
-        return load_sb3(name, base_factory, dt)
+        return load_sb3(name, residual_factory)
     raise PolicyError(f"unknown policy {name!r}: use one of {BASELINES + tuple(SHIPPED)} or a "
                       "path to a .zip")

@@ -254,11 +254,11 @@ def read_wrappers(path: str | Path) -> dict:
         raise PolicyError(f"cannot read the wrapper metadata {meta}: {exc}") from None
 
 
-def load_sb3(path: str | Path, base_factory=None, dt: float = 0.2) -> SB3Policy:
+def load_sb3(path: str | Path, residual_factory=None) -> SB3Policy:
     """Load a saved model (+ its ``_vecnormalize.pkl`` and ``_wrappers.json``); clear errors
-    for a missing or corrupt file. ``base_factory(name, obs_noise)`` builds the base policy of
-    a residual model (required for one); ``dt`` [s] is the control step its command filter
-    runs at."""
+    for a missing or corrupt file. ``residual_factory(spec)`` turns the saved residual block
+    into (base policy, :class:`CommandShaper`), validating it (required for a residual
+    model)."""
     path = Path(path)
     if not path.is_file():
         raise PolicyError(f"policy file not found: {path}")
@@ -296,10 +296,8 @@ def load_sb3(path: str | Path, base_factory=None, dt: float = 0.2) -> SB3Policy:
     residual = None
     if "residual" in wrappers:
         spec = wrappers["residual"]
-        if base_factory is None:
+        if residual_factory is None:
             raise PolicyError(f"{path} is a residual policy on {spec.get('base')!r}: load it "
                               "with load_policy, which builds the base policy")
-        residual = (base_factory(spec["base"], float(spec.get("obs_noise", 0.0))),
-                    CommandShaper(spec["scale"], spec.get("deadband", 0.0),
-                                  spec.get("lowpass", 0.0), dt))
+        residual = residual_factory(spec)
     return SB3Policy(model, norm, frame_stack=k, residual=residual)
