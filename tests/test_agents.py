@@ -101,6 +101,20 @@ def test_policy_for_another_observation_layout_is_rejected(tmp_path):
     assert policy_obs(SB3Policy.__new__(SB3Policy), np.zeros((2, N_OBS))).shape == (2, N_OBS)
 
 
+def test_shipped_policy_scores_its_training_evaluation():
+    """The shipped policy loaded from disk (model, normaliser, residual base and command path,
+    low-pass included) scores the damping suite as its training run's final evaluation did, to
+    1e-12: evaluation runs the command path training ran (a float32 rounding of the summed
+    command dropped before the filter moved this score by 5e-8 and the retrained weights)."""
+    from aerostat_gym.agents.evaluate import suite_score
+
+    last = json.loads(shipped_path("ppo_training", "evaluations.json").read_text())[-1]
+    assert last["timesteps"] >= json.loads(shipped_path(
+        "ppo_training", "training_summary.json").read_text())["timesteps"]
+    assert suite_score(load_policy("shipped"), "damping") == pytest.approx(last["score"],
+                                                                          rel=1e-12)
+
+
 @pytest.mark.slow
 def test_full_training_reaches_shipped_score(tmp_path):
     """Training from scratch with the shipped configuration reaches the shipped policy's suite

@@ -171,11 +171,12 @@ class SB3Policy:
 
 
 def combine_residual(base_action, policy_action, scale: float) -> np.ndarray:
-    """clip(base + scale * clip(policy, -1, 1), -1, 1), shape (N,): the residual's sum, before
-    the command path's low-pass and deadband (:class:`CommandShaper`)."""
+    """clip(base + scale * clip(policy, -1, 1), -1, 1) as float32 (the action's precision),
+    shape (N,): the residual's sum, before the command path's low-pass and deadband
+    (:class:`CommandShaper`; the shipped policies were trained on this rounding)."""
     b = np.asarray(base_action, np.float64).reshape(-1)
     a = np.clip(np.asarray(policy_action, np.float64).reshape(-1), -1.0, 1.0)
-    return np.clip(b + scale * a, -1.0, 1.0)
+    return np.clip(b + scale * a, -1.0, 1.0).astype(np.float32)
 
 
 def lowpass_gain(time_constant: float, dt: float) -> float:
@@ -211,7 +212,7 @@ class CommandShaper:
         """(command (N, 1) float32, filter state (N,)) for one step of N environments;
         ``filtered`` is the previous step's state (None: every environment starts), ``start``
         (N,) bool the environments whose episode starts at this step."""
-        c = combine_residual(base_action, policy_action, self.scale)
+        c = combine_residual(base_action, policy_action, self.scale).astype(np.float64)
         if self.alpha == 1.0:  # no filter: the sum itself, bit for bit
             y = c
         else:
