@@ -2,8 +2,12 @@
 
 from .registration import ENV_ID, register
 
-__version__ = "0.4.0"
+__version__ = "0.5.0"
+#: Oldest version whose registered tasks (dynamics, wind, reward, winch logic) and residual
+#: command path this version reproduces: a policy trained by it or later runs here as it was
+#: trained (0.5 added a baseline and stricter loading; every 0.4 report row reproduced).
+TASKS_COMPATIBLE_SINCE = "0.4.0"
 
 register()
 
-__all__ = ["ENV_ID", "__version__", "register"]
+__all__ = ["ENV_ID", "TASKS_COMPATIBLE_SINCE", "__version__", "register"]

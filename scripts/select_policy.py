@@ -7,7 +7,7 @@ Usage::
 
     aerostat-gym evaluate --suite validation --out runs/val/base --no-plots \\
         --policy passive --policy tension --policy lqr --policy modal --policy lqg \\
-        --policy modal_lqg
+        --policy modal_lqg --policy modal_lqg_shaped
     aerostat-gym evaluate --suite validation --out runs/val/cand --no-plots \\
         --policy runs/seeds/s0/ppo_final.zip ... --policy runs/seeds/s4/ppo_final.zip
     PYTHONPATH=. python scripts/select_policy.py runs/val/base/report.json \\

@@ -1,16 +1,17 @@
 """Frontier of the winch policies: pendulum damping ratio against peak reel speed at 5, 10 and
 15 m/s for the passive (braked) winch, tension feedback, the LQR, the LQG, the modal gains on
-the LQG's filter (modal_lqg), the modal controller's curve and the learned policies, measured in the environment (swing recovery,
-steady wind, the shipped winch and its brake logic), with the modal line's linear end at the
-winch's speed limit.
+the LQG's filter (modal_lqg, and the same through the shipped command path: modal_lqg_shaped),
+the modal controller's curve and the learned policies, measured in the environment (swing
+recovery, steady wind, the shipped winch and its brake logic), with the modal line's linear end
+at the winch's speed limit.
 
 Usage::
 
     PYTHONPATH=. python scripts/winch_frontier.py [--swing 10] [--policy shipped ...]
         [--json docs/figures/frontier.json] [--plot docs/figures/frontier.png]
 
-Every run uses the full-state environment without sensor noise except the two filtering
-baselines (LQG, modal_lqg) and the learned policies (``--policy``, repeatable: a name for
+Every run uses the full-state environment without sensor noise except the filtering
+baselines (LQG, modal_lqg, modal_lqg_shaped) and the learned policies (``--policy``, repeatable: a name for
 :func:`aerostat_gym.agents.policies.load_policy` or a path to an SB3 .zip; default the shipped
 policy), which read the standard observation with sensor noise LQG_NOISE (scaled units, seed
 LQG_SEED): the noise the filters are designed for and the shipped policy was trained with. The
@@ -40,8 +41,15 @@ from aerostat_gym.agents.frontier import (
 from aerostat_gym.agents.lqg import LQGPolicy, LQGSchedule
 from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule
 from aerostat_gym.agents.modal import ModalPolicy, ModalSchedule
-from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy, load_policy
+from aerostat_gym.agents.policies import (
+    SHAPED_DEADBAND,
+    SHAPED_LOWPASS,
+    PassivePolicy,
+    TensionFeedbackPolicy,
+    load_policy,
+)
 from aerostat_gym.agents.protocol import json_safe
+from aerostat_gym.agents.residual import ShapedPolicy
 from aerostat_gym.params import load_params
 
 SPEEDS = (5.0, 10.0, 15.0)
@@ -68,7 +76,8 @@ def _row(policy, kind, designed, run, linear_fit=_NAN) -> dict:
 
 
 def baselines_at(params, U, swing) -> list[dict]:
-    """Passive, tension-feedback, LQR, LQG and modal_lqg rows at one wind speed."""
+    """Passive, tension-feedback, LQR, LQG, modal_lqg and modal_lqg_shaped rows at one wind
+    speed."""
     lqr = LQRSchedule(params, speeds=np.array([U]))
     d = lqr.designs[0]
     designed = float(d.mode("pendulum").zeta)
@@ -79,6 +88,9 @@ def baselines_at(params, U, swing) -> list[dict]:
                                                  obs_noise=LQG_NOISE))
     modal_lqg = LQGPolicy(params, schedule=LQGSchedule(params, speeds=np.array([U]),
                                                        obs_noise=LQG_NOISE, gains="modal"))
+    modal_zeta = modal_lqg.schedule.designs[0].modes["pendulum"]["closed"]["zeta"]
+    shaped = ShapedPolicy(LQGPolicy(params, schedule=modal_lqg.schedule),
+                          deadband=SHAPED_DEADBAND, lowpass=SHAPED_LOWPASS)
     return [
         _row("passive", "passive", braked, swing_response(PassivePolicy(), U, swing)),
         _row("tension", "baseline", None,
@@ -87,8 +99,10 @@ def baselines_at(params, U, swing) -> list[dict]:
              swing_response(LQRPolicy(params, schedule=lqr), U, swing), lin),
         _row("lqg", "baseline", designed,
              swing_response(lqg, U, swing, obs_noise=LQG_NOISE, seed=LQG_SEED), lin),
-        _row("modal_lqg", "baseline", modal_lqg.schedule.designs[0].modes["pendulum"]["closed"]
-             ["zeta"], swing_response(modal_lqg, U, swing, obs_noise=LQG_NOISE, seed=LQG_SEED)),
+        _row("modal_lqg", "baseline", modal_zeta,
+             swing_response(modal_lqg, U, swing, obs_noise=LQG_NOISE, seed=LQG_SEED)),
+        _row("modal_lqg_shaped", "baseline", modal_zeta,
+             swing_response(shaped, U, swing, obs_noise=LQG_NOISE, seed=LQG_SEED)),
     ]
 
 

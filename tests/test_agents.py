@@ -103,16 +103,20 @@ def test_policy_for_another_observation_layout_is_rejected(tmp_path):
 
 def test_shipped_policy_scores_its_training_evaluation():
     """The shipped policy loaded from disk (model, normaliser, residual base and command path,
-    low-pass included) scores the damping suite as its training run's final evaluation did, to
-    1e-12: evaluation runs the command path training ran (a float32 rounding of the summed
-    command dropped before the filter moved this score by 5e-8 and the retrained weights)."""
+    low-pass included) scores the damping suite as its training run's final evaluation did,
+    within 2e-8 (absolute): evaluation runs the command path training ran (a float32 rounding of
+    the summed command dropped before the filter moved this score by 5e-8 and the retrained
+    weights). On the machine that trained it the score is equal to 1e-12; on another CPU the
+    network's float32 arithmetic rounds differently and the score moved by 8e-9 (session 10),
+    so the tolerance sits between the two. The in-process training-evaluation identity is
+    exact (tests/test_learned.py)."""
     from aerostat_gym.agents.evaluate import suite_score
 
     last = json.loads(shipped_path("ppo_training", "evaluations.json").read_text())[-1]
     assert last["timesteps"] >= json.loads(shipped_path(
         "ppo_training", "training_summary.json").read_text())["timesteps"]
     assert suite_score(load_policy("shipped"), "damping") == pytest.approx(last["score"],
-                                                                          rel=1e-12)
+                                                                          rel=0, abs=2e-8)
 
 
 @pytest.mark.slow

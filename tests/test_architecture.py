@@ -19,7 +19,7 @@ LAYERS = (
     ("aerostat_gym.envs",),
     ("aerostat_gym.agents",),
     ("aerostat_gym.bench", "aerostat_gym.scale"),
-    ("aerostat_gym.cli",),
+    ("aerostat_gym.cli", "aerostat_gym.__main__"),  # __main__: python -m aerostat_gym
 )
 
 

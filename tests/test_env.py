@@ -131,6 +131,9 @@ def test_invalid_arguments_name_the_problem():
         TetheredAerostatEnv(perturbation="earthquake")
     with pytest.raises(ValueError, match="render_mode"):
         TetheredAerostatEnv(render_mode="ascii")
+    for noise in (-0.01, float("nan"), True, "0.01"):  # one shared check (envs.spaces)
+        with pytest.raises(TaskError, match="obs_noise"):
+            TetheredAerostatEnv(obs_noise=noise)
 
 
 def test_reset_starts_at_exact_trim_without_perturbation():

@@ -62,10 +62,11 @@ def test_registered_tasks_reproduce_their_conditions(task_id):
 
 
 def test_shipped_policy_trained_on_its_registered_task():
-    """The shipped PPO was trained by this package version on the task its hyperparameter block
+    """The shipped PPO was trained by a compatible package version on the task its hyperparameter block
     is keyed by: the recorded run's block equals the shipped YAML's, its summary names the same
-    task, and its version record is this package's version (so gym.make(task_id) is the
-    training environment, reward and winch logic included)."""
+    task, and its version record lies between aerostat_gym.TASKS_COMPATIBLE_SINCE and this
+    package's version (so gym.make(task_id) is the training environment, reward and winch logic
+    included)."""
     task_id, hp, project = load_hyperparams("ppo")
     assert task_id == "TetheredAerostatRealistic-v0"
     run = ROOT / "agents" / "ppo_training"
@@ -73,7 +74,12 @@ def test_shipped_policy_trained_on_its_registered_task():
     assert set(recorded) == {task_id, "aerostat_gym"}
     assert recorded[task_id] == hp and recorded["aerostat_gym"] == project
     assert json.loads((run / "training_summary.json").read_text())["task"] == task_id
-    assert json.loads((run / "version.json").read_text())["aerostat_gym"] == aerostat_gym.__version__
+    def version(text):
+        return tuple(int(p) for p in text.split("."))
+
+    trained = version(json.loads((run / "version.json").read_text())["aerostat_gym"])
+    assert version(aerostat_gym.TASKS_COMPATIBLE_SINCE) <= trained <= version(
+        aerostat_gym.__version__)
     assert project == {"eval_freq": 200000, "eval_suite": "damping",
                        "residual": {"base": "modal_lqg", "scale": 0.1, "deadband": 0.03,
                                     "lowpass": 1.0}}
@@ -144,6 +150,16 @@ def test_bad_input_is_one_line_on_stderr(tmp_path, args, needle):
     assert out.returncode == 2
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], out.stderr[-1000:]
+
+
+def test_package_runs_as_a_module(tmp_path):
+    """``python -m aerostat_gym`` is the ``aerostat-gym`` command; ``--version`` prints the
+    package's version."""
+    env = {**os.environ, "PYTHONPATH": ""}
+    out = subprocess.run([sys.executable, "-m", "aerostat_gym", "--version"], cwd=tmp_path,
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-1000:]
+    assert out.stdout.strip() == f"aerostat-gym {aerostat_gym.__version__}"
 
 
 def test_help_has_defaults_and_no_markup():

@@ -248,6 +248,38 @@ def test_command_lowpass_closed_form():
             check_residual({"base": "modal_lqg", "lowpass": bad})
 
 
+def test_shaped_baseline_is_modal_lqg_through_the_command_path():
+    """The ``modal_lqg_shaped`` baseline's command is ``modal_lqg``'s passed through the
+    first-order low-pass y_k = y_{k-1} + alpha (a_k - y_{k-1}) from rest, alpha =
+    1 - exp(-dt / SHAPED_LOWPASS), then zeroed under SHAPED_DEADBAND: checked against that
+    recursion written out here on a swinging observation sequence (float32 commands, 1e-6)."""
+    from aerostat_gym.agents.policies import SHAPED_DEADBAND, SHAPED_LOWPASS, load_policy
+    from aerostat_gym.envs.spaces import CHANNELS, OBS_DX, OBS_VX, OBS_WIND_X
+
+    dt, steps = 0.2, 60
+    t = np.arange(steps) * dt
+    obs = np.zeros((steps, 1, N_OBS), np.float32)
+    obs[:, 0, OBS_DX] = 0.8 * np.cos(2 * np.pi * t / 40.0)   # a 8 m, 40 s swing (10 m scale)
+    obs[:, 0, OBS_VX] = -0.63 * np.sin(2 * np.pi * t / 40.0)
+    obs[:, 0, OBS_WIND_X] = 10.0 / CHANNELS[OBS_WIND_X].scale  # the schedule's 10 m/s
+    base = load_policy("modal_lqg", dt=dt, obs_noise=0.01)
+    shaped = load_policy("modal_lqg_shaped", dt=dt, obs_noise=0.01)
+    alpha = 1.0 - np.exp(-dt / SHAPED_LOWPASS)
+    sb = ss = None
+    y, expected, got = 0.0, [], []
+    for k in range(steps):
+        start = np.array([k == 0])
+        a, sb = base.predict(obs[k], state=sb, episode_start=start)
+        c, ss = shaped.predict(obs[k], state=ss, episode_start=start)
+        y += alpha * (float(a[0, 0]) - y)
+        expected.append(0.0 if abs(y) < SHAPED_DEADBAND else y)
+        got.append(float(c[0, 0]))
+    expected, got = np.array(expected), np.array(got)
+    assert np.ptp(expected) > 0.1 and np.any(expected == 0.0)  # the swing moves it; the band acts
+    np.testing.assert_allclose(got, expected, rtol=1e-6, atol=1e-7)
+    assert np.all(got[expected == 0.0] == 0.0)
+
+
 @pytest.mark.parametrize("base", ["modal", "lqr"])
 def test_residual_refuses_privileged_bases(base):
     with pytest.raises(TrainingError, match="privileged full state"):
@@ -260,8 +292,8 @@ def test_residual_refuses_privileged_bases(base):
 
 def test_residual_model_needs_its_base(tmp_path):
     """A residual model's metadata is honoured by load_policy and required by load_sb3; a
-    corrupt residual block (privileged base, bad low-pass, deadband or sensor noise) is refused
-    at the door with the key named."""
+    corrupt residual block (privileged base, bad low-pass, deadband or sensor noise) or an
+    unknown top-level key is refused at the door with the key named."""
     from aerostat_gym.agents.sb3io import load_sb3
 
     algo, config = _config(tmp_path, "residual-ppo")
@@ -277,6 +309,10 @@ def test_residual_model_needs_its_base(tmp_path):
         meta.write_text(json.dumps({"residual": block}))
         with pytest.raises(PolicyError, match=match):
             load_policy(str(run / "ppo_final.zip"))
+    # a key from a newer writer is refused, not dropped (it would run a different policy)
+    meta.write_text(json.dumps({"residual": {"base": "lqg", "scale": 0.3}, "action_delay": 2}))
+    with pytest.raises(PolicyError, match=r"does not know: \['action_delay'\]"):
+        load_policy(str(run / "ppo_final.zip"))
 
 
 def test_normalisation_floor_on_a_channel_constant_in_training():

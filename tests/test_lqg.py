@@ -132,6 +132,8 @@ def test_policy_interface(params, schedule):
         pol.predict(np.zeros(5))
     with pytest.raises(ValueError, match="obs_noise"):
         design_lqg(params, 10.0, obs_noise=-1.0)
+    with pytest.raises(ValueError, match="obs_noise"):
+        design_lqg(params, 10.0, obs_noise=True)
 
 
 def test_nonlinear_damping_with_sensor_noise(params, schedule):

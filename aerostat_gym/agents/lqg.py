@@ -47,7 +47,7 @@ import scipy.linalg as sla
 
 from ..analysis.linear import state_steps
 from ..analysis.trim import find_equilibrium
-from ..envs.spaces import CHANNELS, N_OBS
+from ..envs.spaces import CHANNELS, N_OBS, check_obs_noise
 from ..params import Params
 from ..physics.state import StateLayout
 from ..sim import Model
@@ -135,9 +135,7 @@ def measurement_matrix(params: Params, lqr: LQRDesign, idx: np.ndarray) -> np.nd
 def measurement_noise(obs_noise: float) -> np.ndarray:
     """R = diag((sigma scale_k)^2) for the measured channels, sigma = max(obs_noise,
     MIN_NOISE) in the environment's scaled units."""
-    if not (isinstance(obs_noise, float | int) and math.isfinite(obs_noise) and obs_noise >= 0):
-        raise ValueError(f"obs_noise must be a finite number >= 0, got {obs_noise!r}")
-    sigma = max(float(obs_noise), MIN_NOISE)
+    sigma = max(check_obs_noise(obs_noise), MIN_NOISE)
     return np.diag([(sigma * CHANNELS[i].scale) ** 2 for i in MEASURED.values()])
 
 

@@ -9,6 +9,10 @@ deterministic)`` signature, so one evaluator runs baselines and trained models a
   modal gains.
 - :class:`aerostat_gym.agents.lqg.LQGPolicy`: a Kalman filter on the standard observation with
   the LQR's (``lqg``) or the modal design's (``modal_lqg``) gains.
+- ``modal_lqg_shaped``: ``modal_lqg`` through the shipped residual's command path without the
+  learning (:class:`aerostat_gym.agents.residual.ShapedPolicy`: :data:`SHAPED_LOWPASS`,
+  :data:`SHAPED_DEADBAND`), the strongest policy on the noisy sensors and the bar a learned
+  residual on it has to clear.
 - :class:`aerostat_gym.agents.sb3io.SB3Policy`: a trained model with its VecNormalize
   statistics.
 
@@ -17,22 +21,28 @@ deterministic)`` signature, so one evaluator runs baselines and trained models a
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 
 from ..analysis.reference import reference_periods
-from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION
+from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION, check_obs_noise
 from ..params import Params, load_params
 from ..resources import SHIPPED_POLICY, shipped_path
 from .lqg import LQGPolicy
 from .lqr import LQRPolicy
 from .modal import ModalPolicy
-from .residual import check_residual, residual_shaper
+from .residual import ShapedPolicy, check_residual, residual_shaper
 from .sb3io import PolicyError, as_batch, load_sb3, to_actions
 
-BASELINES = ("passive", "tension", "lqr", "modal", "lqg", "modal_lqg")
+BASELINES = ("passive", "tension", "lqr", "modal", "lqg", "modal_lqg", "modal_lqg_shaped")
+#: The command path of ``modal_lqg_shaped``: a first-order low-pass of 1 s on the set-point, then
+#: a deadband of 0.03 of the winch's top speed (smaller commands brake). Calibrated, the values
+#: of the shipped residual's ``agents/hyperparams/ppo.yml`` block: the deadband between the 0.02
+#: and 0.05 tried in session 7, the low-pass the best of 0.5 / 1 / 2 s with ``modal_lqg`` on the
+#: validation suite in session 9 (docs/learned.md).
+SHAPED_LOWPASS = 1.0
+SHAPED_DEADBAND = 0.03
 #: Names of trained policies that ship with the package.
 SHIPPED = {"shipped": SHIPPED_POLICY}
 #: Tension feedback in units of the configuration: reel speed per tension excess, as a fraction
@@ -104,7 +114,9 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     LQR over the wind range, privileged full state), 'modal' (pendulum pole placement,
     privileged full state), 'lqg' (Kalman filter on the standard channels designed for the
     sensor noise ``obs_noise``, with the LQR gains), 'modal_lqg' (the same filter driving the
-    modal gains: the frontier controller on the information a learned policy has).
+    modal gains: the frontier controller on the information a learned policy has),
+    'modal_lqg_shaped' (``modal_lqg`` with a 1 s command low-pass and a 0.03 deadband: the
+    shipped residual's command path without the learning).
 
     A saved model's wrapper metadata (``<stem>_wrappers.json``) is honoured: its frame stack,
     and its residual base rebuilt for ``params`` and ``dt`` with the sensor noise it was
@@ -115,13 +127,9 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     def residual_factory(spec: dict):
         """A saved residual block validated at the door, as (base policy, command path)."""
         res = check_residual({k: v for k, v in spec.items() if k != "obs_noise"})
-        noise = spec.get("obs_noise", 0.0)
-        if isinstance(noise, bool) or not isinstance(noise, (int, float)) \
-                or not (math.isfinite(noise) and noise >= 0):
-            raise PolicyError(f"the residual block's obs_noise must be a finite number >= 0, "
-                              f"got {noise!r}")
+        noise = check_obs_noise(spec.get("obs_noise", 0.0), PolicyError)
         base = load_policy(res["base"], params=params, dt=dt, wind_range=wind_range,
-                           obs_noise=float(noise))
+                           obs_noise=noise)
         return base, residual_shaper(res, dt)
 
     if name == "passive":
@@ -136,6 +144,9 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
         return LQGPolicy(params, dt=dt, obs_noise=obs_noise)
     if name == "modal_lqg":
         return LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal")
+    if name == "modal_lqg_shaped":
+        return ShapedPolicy(LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal"),
+                            deadband=SHAPED_DEADBAND, lowpass=SHAPED_LOWPASS, dt=dt)
     if name in SHIPPED:
         return load_sb3(shipped_path(SHIPPED[name]), residual_factory)
     if name.endswith(".zip") or Path(name).exists():

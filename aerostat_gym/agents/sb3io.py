@@ -29,6 +29,8 @@ VECNORM_SUFFIX = "_vecnormalize.pkl"
 WRAPPERS_SUFFIX = "_wrappers.json"
 #: Wrapper metadata of every model in a folder (a run's checkpoints/).
 FOLDER_WRAPPERS = "wrappers.json"
+#: The top-level keys of the wrapper metadata; any other is refused on reading.
+WRAPPER_KEYS = frozenset({"frame_stack", "residual"})
 
 
 class PolicyError(ValueError):
@@ -250,9 +252,16 @@ def read_wrappers(path: str | Path) -> dict:
     if not meta.is_file():
         return {}
     try:
-        return clean_wrappers(json.loads(meta.read_text()))
+        data = json.loads(meta.read_text())
+        unknown = sorted(set(data) - WRAPPER_KEYS)
+        wrappers = clean_wrappers(data)
     except (ValueError, TypeError, AttributeError) as exc:
         raise PolicyError(f"cannot read the wrapper metadata {meta}: {exc}") from None
+    if unknown:  # a newer writer's wrapper: dropping it would run a different policy
+        raise PolicyError(f"the wrapper metadata {meta} has keys this version of aerostat-gym "
+                          f"does not know: {unknown} (known: {sorted(WRAPPER_KEYS)}); it was "
+                          "written by a newer version")
+    return wrappers
 
 
 def load_sb3(path: str | Path, residual_factory=None) -> SB3Policy:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from .. import __version__
 from ..params import ParameterError
 from .agents import add_agent_parsers
 from .common import OneLineParser
@@ -49,6 +50,8 @@ class Parser(OneLineParser):
 
 def build_parser() -> argparse.ArgumentParser:
     ap = Parser(prog="aerostat-gym", description=DESCRIPTION)
+    ap.add_argument("--version", action="version", version=f"aerostat-gym {__version__}",
+                    help="print the version and exit")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=Parser,
                             metavar="COMMAND")
     add_model_parsers(sub)

@@ -13,6 +13,7 @@ from ..params import ParameterError, Params, apply_overrides, load_params
 from ..sim import INTEGRATORS
 from ..wind.sizing import sized_turbulence
 from . import reward
+from .spaces import check_obs_noise
 
 #: Perturbation presets: maximum along-wind swing and lateral displacement of the aerostat [m]
 #: (a rigid rotation of aerostat and tether about the winch), pitch kick about the confluence
@@ -92,9 +93,7 @@ class TaskConfig:
         if self.observation not in ("standard", "full"):
             raise TaskError(f"unknown observation {self.observation!r}; choose 'standard' or "
                             "'full'")
-        if not (isinstance(self.obs_noise, (int, float)) and math.isfinite(self.obs_noise)
-                and self.obs_noise >= 0):
-            raise TaskError(f"obs_noise must be a finite number >= 0, got {self.obs_noise!r}")
+        check_obs_noise(self.obs_noise, TaskError)
         try:
             r["weights"] = reward.weights_vector(self.reward_weights)
             reward.check_reward_fn(self.reward_fn)
