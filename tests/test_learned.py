@@ -232,6 +232,14 @@ def test_command_lowpass_closed_form():
     _, y = shaper([u, u], [0.0, 0.0], y, np.array([True, False]))
     np.testing.assert_allclose(y, [exact[0], exact[6]], rtol=1e-12)  # env 0 restarts
     assert CommandShaper(0.1, lowpass=0.0).alpha == 1.0
+    # lowpass_on="base": the base command is filtered, the residual added after it, unfiltered
+    on_base, y = CommandShaper(0.1, lowpass=tau, dt=dt, lowpass_on="base"), None
+    for k in range(3):
+        cmd, y = on_base([u], [0.5], y, np.array([k == 0]))
+    assert cmd[0, 0] == pytest.approx(exact[2] + 0.1 * 0.5, rel=1e-6)
+    np.testing.assert_allclose(y, [exact[2]], rtol=1e-12)  # the state is the filtered base
+    with pytest.raises(PolicyError, match="lowpass_on"):
+        check_residual({"base": "modal_lqg", "lowpass_on": "policy"})
 
     class Step:
         def predict(self, obs, state=None, episode_start=None, deterministic=True):

@@ -26,10 +26,12 @@ import math
 import numpy as np
 
 from ..envs.spaces import N_OBS
-from .sb3io import CommandShaper, PolicyError
+from .sb3io import LOWPASS_ON, CommandShaper, PolicyError
 
 #: Baselines that read the standard observation only, allowed as residual bases.
 RESIDUAL_BASES = ("lqg", "modal_lqg", "tension")
+#: Keys of a residual block.
+RESIDUAL_KEYS = frozenset({"base", "scale", "deadband", "lowpass", "lowpass_on"})
 #: Baselines that read the privileged full state: refused.
 PRIVILEGED_BASES = ("lqr", "modal")
 
@@ -42,10 +44,9 @@ MAX_LOWPASS = 4.0
 def check_residual(spec) -> dict:
     """The residual block {base, scale[, deadband][, lowpass]} validated (a clear PolicyError
     otherwise); the deadband and the low-pass are returned only when they are set."""
-    if not isinstance(spec, dict) or set(spec) - {"base", "scale", "deadband", "lowpass"} \
-            or "base" not in spec:
+    if not isinstance(spec, dict) or set(spec) - RESIDUAL_KEYS or "base" not in spec:
         raise PolicyError("residual must be a mapping {base: NAME, scale: S[, deadband: D]"
-                          f"[, lowpass: TAU]}}, got {spec!r}")
+                          f"[, lowpass: TAU][, lowpass_on: sum|base]}}, got {spec!r}")
     base = spec["base"]
     if base in PRIVILEGED_BASES:
         raise PolicyError(f"residual base {base!r} reads the privileged full state: learned and "
@@ -62,6 +63,11 @@ def check_residual(spec) -> dict:
         out["deadband"] = check_deadband(spec["deadband"])
     if "lowpass" in spec:
         out["lowpass"] = check_lowpass(spec["lowpass"])
+    if "lowpass_on" in spec:
+        if spec["lowpass_on"] not in LOWPASS_ON:
+            raise PolicyError(f"residual lowpass_on must be one of {LOWPASS_ON}, got "
+                              f"{spec['lowpass_on']!r}")
+        out["lowpass_on"] = spec["lowpass_on"]
     return out
 
 
@@ -76,7 +82,8 @@ def check_lowpass(tau) -> float:
 
 def residual_shaper(spec: dict, dt: float) -> CommandShaper:
     """The command path of a validated residual block at control step ``dt`` [s]."""
-    return CommandShaper(spec["scale"], spec.get("deadband", 0.0), spec.get("lowpass", 0.0), dt)
+    return CommandShaper(spec["scale"], spec.get("deadband", 0.0), spec.get("lowpass", 0.0), dt,
+                         spec.get("lowpass_on", "sum"))
 
 
 def check_deadband(d) -> float:

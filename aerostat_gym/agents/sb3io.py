@@ -29,6 +29,9 @@ VECNORM_SUFFIX = "_vecnormalize.pkl"
 WRAPPERS_SUFFIX = "_wrappers.json"
 #: Wrapper metadata of every model in a folder (a run's checkpoints/).
 FOLDER_WRAPPERS = "wrappers.json"
+#: What the command low-pass filters: the summed command, or the base's alone (the residual
+#: then adds to the filtered base command, unfiltered).
+LOWPASS_ON = ("sum", "base")
 #: The top-level keys of the wrapper metadata; any other is refused on reading.
 WRAPPER_KEYS = frozenset({"frame_stack", "residual"})
 
@@ -205,23 +208,33 @@ class CommandShaper:
     """
 
     def __init__(self, scale: float, deadband: float = 0.0, lowpass: float = 0.0,
-                 dt: float = 0.2):
+                 dt: float = 0.2, lowpass_on: str = "sum"):
+        if lowpass_on not in LOWPASS_ON:
+            raise PolicyError(f"lowpass_on must be one of {LOWPASS_ON}, got {lowpass_on!r}")
         self.scale, self.deadband = float(scale), float(deadband)
-        self.lowpass, self.dt = float(lowpass), float(dt)
+        self.lowpass, self.dt, self.lowpass_on = float(lowpass), float(dt), lowpass_on
         self.alpha = lowpass_gain(self.lowpass, self.dt)
+
+    def _filter(self, u, filtered, start) -> np.ndarray:
+        """One step of the low-pass on u (N,) from the previous state ``filtered``."""
+        y = np.zeros_like(u) if filtered is None else np.array(filtered, np.float64)
+        if start is not None:
+            y[np.asarray(start, bool).reshape(-1)] = 0.0
+        return y + self.alpha * (u - y)
 
     def __call__(self, base_action, policy_action, filtered=None, start=None):
         """(command (N, 1) float32, filter state (N,)) for one step of N environments;
         ``filtered`` is the previous step's state (None: every environment starts), ``start``
         (N,) bool the environments whose episode starts at this step."""
-        c = combine_residual(base_action, policy_action, self.scale).astype(np.float64)
         if self.alpha == 1.0:  # no filter: the sum itself, bit for bit
-            y = c
-        else:
-            y = np.zeros_like(c) if filtered is None else np.array(filtered, np.float64)
-            if start is not None:
-                y[np.asarray(start, bool).reshape(-1)] = 0.0
-            y = y + self.alpha * (c - y)
+            y = combine_residual(base_action, policy_action, self.scale).astype(np.float64)
+            return apply_deadband(y, self.deadband)[:, None], y
+        if self.lowpass_on == "base":  # the residual bypasses the filter
+            y = self._filter(np.asarray(base_action, np.float64).reshape(-1), filtered, start)
+            c = combine_residual(y, policy_action, self.scale).astype(np.float64)
+            return apply_deadband(c, self.deadband)[:, None], y
+        c = combine_residual(base_action, policy_action, self.scale).astype(np.float64)
+        y = self._filter(c, filtered, start)
         return apply_deadband(y, self.deadband)[:, None], y
 
 
