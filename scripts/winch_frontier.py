@@ -11,9 +11,9 @@ Usage::
         [--json docs/figures/frontier.json] [--plot docs/figures/frontier.png]
 
 Every run uses the full-state environment without sensor noise except the filtering
-baselines (LQG, modal_lqg, modal_lqg_shaped) and the learned policies (``--policy``, repeatable: a name for
-:func:`aerostat_gym.agents.policies.load_policy` or a path to an SB3 .zip; default the shipped
-policy), which read the standard observation with sensor noise LQG_NOISE (scaled units, seed
+baselines (LQG, modal_lqg, modal_lqg_shaped) and the learned policies (``--policy``,
+repeatable: a name for :func:`aerostat_gym.agents.policies.load_policy` or a path to an SB3
+.zip; default the shipped policy), which read the standard observation with sensor noise LQG_NOISE (scaled units, seed
 LQG_SEED): the noise the filters are designed for and the shipped policy was trained with. The
 learned policies act deterministically.
 """

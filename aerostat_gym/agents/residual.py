@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 from ..envs.spaces import N_OBS
-from .sb3io import LOWPASS_ON, CommandShaper, PolicyError
+from .sb3io import CommandShaper, PolicyError, check_lowpass_on
 
 #: Baselines that read the standard observation only, allowed as residual bases.
 RESIDUAL_BASES = ("lqg", "modal_lqg", "tension")
@@ -42,8 +42,8 @@ MAX_LOWPASS = 4.0
 
 
 def check_residual(spec) -> dict:
-    """The residual block {base, scale[, deadband][, lowpass]} validated (a clear PolicyError
-    otherwise); the deadband and the low-pass are returned only when they are set."""
+    """The residual block {base, scale[, deadband][, lowpass][, lowpass_on]} validated (a clear
+    PolicyError otherwise); the optional keys are returned only when they are set."""
     if not isinstance(spec, dict) or set(spec) - RESIDUAL_KEYS or "base" not in spec:
         raise PolicyError("residual must be a mapping {base: NAME, scale: S[, deadband: D]"
                           f"[, lowpass: TAU][, lowpass_on: sum|base]}}, got {spec!r}")
@@ -64,10 +64,7 @@ def check_residual(spec) -> dict:
     if "lowpass" in spec:
         out["lowpass"] = check_lowpass(spec["lowpass"])
     if "lowpass_on" in spec:
-        if spec["lowpass_on"] not in LOWPASS_ON:
-            raise PolicyError(f"residual lowpass_on must be one of {LOWPASS_ON}, got "
-                              f"{spec['lowpass_on']!r}")
-        out["lowpass_on"] = spec["lowpass_on"]
+        out["lowpass_on"] = check_lowpass_on(spec["lowpass_on"])
     return out
 
 

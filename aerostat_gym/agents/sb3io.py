@@ -184,6 +184,13 @@ def combine_residual(base_action, policy_action, scale: float) -> np.ndarray:
     return np.clip(b + scale * a, -1.0, 1.0).astype(np.float32)
 
 
+def check_lowpass_on(value) -> str:
+    """What the command low-pass filters, one of :data:`LOWPASS_ON` (else a PolicyError)."""
+    if not isinstance(value, str) or value not in LOWPASS_ON:
+        raise PolicyError(f"residual lowpass_on must be one of {LOWPASS_ON}, got {value!r}")
+    return value
+
+
 def lowpass_gain(time_constant: float, dt: float) -> float:
     """alpha of the first-order low-pass y <- y + alpha (u - y) that holds u over each control
     step dt: the exact zero-order-hold discretisation of tau dy/dt = u - y, alpha =
@@ -209,10 +216,9 @@ class CommandShaper:
 
     def __init__(self, scale: float, deadband: float = 0.0, lowpass: float = 0.0,
                  dt: float = 0.2, lowpass_on: str = "sum"):
-        if lowpass_on not in LOWPASS_ON:
-            raise PolicyError(f"lowpass_on must be one of {LOWPASS_ON}, got {lowpass_on!r}")
         self.scale, self.deadband = float(scale), float(deadband)
-        self.lowpass, self.dt, self.lowpass_on = float(lowpass), float(dt), lowpass_on
+        self.lowpass, self.dt = float(lowpass), float(dt)
+        self.lowpass_on = check_lowpass_on(lowpass_on)
         self.alpha = lowpass_gain(self.lowpass, self.dt)
 
     def _filter(self, u, filtered, start) -> np.ndarray:
