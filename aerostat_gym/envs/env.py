@@ -188,6 +188,9 @@ class TetheredAerostatEnv(gym.Env):
     - v0 (aerostat-gym 0.4; dynamics, observation and reward unchanged): new task id
       ``TetheredAerostatRealistic-v0`` (light turbulence, swing perturbations, randomised
       estimated parameters, sensor noise 0.01), the shipped policy's task.
+    - v0 (aerostat-gym 0.5; dynamics, observation and reward unchanged, every 0.4 evaluation
+      reproduced): ``obs_noise`` is refused unless a finite real number >= 0 (``True`` was taken
+      as 1.0).
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
