@@ -42,14 +42,12 @@ from aerostat_gym.agents.lqg import LQGPolicy, LQGSchedule
 from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule
 from aerostat_gym.agents.modal import ModalPolicy, ModalSchedule
 from aerostat_gym.agents.policies import (
-    SHAPED_DEADBAND,
-    SHAPED_LOWPASS,
     PassivePolicy,
     TensionFeedbackPolicy,
     load_policy,
+    shaped_command,
 )
 from aerostat_gym.agents.protocol import json_safe
-from aerostat_gym.agents.residual import ShapedPolicy
 from aerostat_gym.params import load_params
 
 SPEEDS = (5.0, 10.0, 15.0)
@@ -89,8 +87,7 @@ def baselines_at(params, U, swing) -> list[dict]:
     modal_lqg = LQGPolicy(params, schedule=LQGSchedule(params, speeds=np.array([U]),
                                                        obs_noise=LQG_NOISE, gains="modal"))
     modal_zeta = modal_lqg.schedule.designs[0].modes["pendulum"]["closed"]["zeta"]
-    shaped = ShapedPolicy(LQGPolicy(params, schedule=modal_lqg.schedule),
-                          deadband=SHAPED_DEADBAND, lowpass=SHAPED_LOWPASS)
+    shaped = shaped_command(LQGPolicy(params, schedule=modal_lqg.schedule))
     return [
         _row("passive", "passive", braked, swing_response(PassivePolicy(), U, swing)),
         _row("tension", "baseline", None,

@@ -62,11 +62,11 @@ def test_registered_tasks_reproduce_their_conditions(task_id):
 
 
 def test_shipped_policy_trained_on_its_registered_task():
-    """The shipped PPO was trained by a compatible package version on the task its hyperparameter block
-    is keyed by: the recorded run's block equals the shipped YAML's, its summary names the same
-    task, and its version record lies between aerostat_gym.TASKS_COMPATIBLE_SINCE and this
-    package's version (so gym.make(task_id) is the training environment, reward and winch logic
-    included)."""
+    """The shipped PPO was trained by a compatible package version on the task its
+    hyperparameter block is keyed by: the recorded run's block equals the shipped YAML's, its
+    summary names the same task, and its version record lies between
+    aerostat_gym.TASKS_COMPATIBLE_SINCE and this package's version (so gym.make(task_id) is the
+    training environment, reward and winch logic included)."""
     task_id, hp, project = load_hyperparams("ppo")
     assert task_id == "TetheredAerostatRealistic-v0"
     run = ROOT / "agents" / "ppo_training"

@@ -105,6 +105,12 @@ class TensionFeedbackPolicy:
         return to_actions(v / self.max_speed, single), state
 
 
+def shaped_command(policy, dt: float = 0.2) -> ShapedPolicy:
+    """``policy`` through the ``modal_lqg_shaped`` command path (:data:`SHAPED_LOWPASS`, then
+    :data:`SHAPED_DEADBAND`) at control step ``dt`` [s]."""
+    return ShapedPolicy(policy, deadband=SHAPED_DEADBAND, lowpass=SHAPED_LOWPASS, dt=dt)
+
+
 def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
                 obs_noise: float = 0.0):
     """A baseline by name designed for ``params`` (default: the baseline), a shipped trained
@@ -145,8 +151,7 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     if name == "modal_lqg":
         return LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal")
     if name == "modal_lqg_shaped":
-        return ShapedPolicy(LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal"),
-                            deadband=SHAPED_DEADBAND, lowpass=SHAPED_LOWPASS, dt=dt)
+        return shaped_command(LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal"), dt)
     if name in SHIPPED:
         return load_sb3(shipped_path(SHIPPED[name]), residual_factory)
     if name.endswith(".zip") or Path(name).exists():
