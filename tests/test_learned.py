@@ -41,6 +41,14 @@ VARIANTS = {
                            {"residual": {"base": "modal_lqg", "scale": 0.1}}, 1024),
     "stack-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
                   {"frame_stack": 4}, 1024),
+    "score-mix-residual-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
+                               {"residual": {"base": "modal_lqg", "scale": 0.1},
+                                "score_reward": True,
+                                "env_kwargs": {"turbulence": "light", "perturbation":
+                                               "displacement", "randomize": True,
+                                               "obs_noise": 0.01, "turbulence_mix":
+                                               {"none": 0.5, "light": 0.25, "moderate": 0.25}}},
+                               1024),
 }
 SMOKE_ENV = {"turbulence": "light", "perturbation": "displacement", "randomize": True,
              "obs_noise": 0.01}

@@ -20,6 +20,7 @@ from aerostat_gym.agents.evaluate import (
     suite_seeds,
 )
 from aerostat_gym.agents.metrics import response_metrics
+from aerostat_gym.agents.poi_split import poi_split, split_markdown
 from aerostat_gym.agents.policies import PassivePolicy
 from aerostat_gym.agents.protocol import cell_markdown, protocol, protocol_markdown
 from aerostat_gym.agents.returns import RETURN_SEEDS
@@ -298,3 +299,30 @@ def test_policy_labels_stay_distinct():
                                               "b/ppo_final", "model"]
     with pytest.raises(ValueError, match="listed twice"):
         policy_labels(["lqr", "lqr"])
+
+
+def test_poi_split_on_constructed_results():
+    """Two calm cells and one turbulent cell, four seeds: X beats Y by 1 in one calm cell on
+    every seed (P 1), loses by 1 in the other (P 0), and in the turbulent cell is better by 1 on
+    every seed while the seeds spread by 100: the unpaired P there is the Mann-Whitney value
+    (X's seed k beats Y's seeds k to 4: 10 of 16 pairs), the paired win rate 1; the bound
+    counts both calm cells as won: (1 + 1 + 10/16) / 3."""
+    seeds = (1, 2, 3, 4)
+
+    def res(label, calm_a, calm_b, shift):
+        return {"label": label, "suite": "report", "score": 0.0, "scenarios": {
+            "recover": {"episodes": [_episode(s, **{"return": calm_a}) for s in seeds]},
+            "recover_small": {"episodes": [_episode(s, **{"return": calm_b}) for s in seeds]},
+            "gusty": {"episodes": [_episode(s, **{"return": -100.0 * s + shift})
+                                   for s in seeds]}}}
+
+    results = [res("passive", -60.0, -6.0, -50.0), res("x", -50.0, -6.0, 1.0),
+               res("y", -51.0, -5.0, 0.0)]
+    split = poi_split(results, "x", "y")
+    assert split["calm"] == 0.5 and split["calm_cells"] == 2 and split["turbulent_cells"] == 1
+    assert split["turbulent"] == 10 / 16 and split["turbulent_paired_win"] == 1.0
+    assert split["p"] == pytest.approx((1.0 + 0.0 + 10 / 16) / 3)
+    assert split["bound"] == pytest.approx((2.0 + 10 / 16) / 3)
+    assert "| x | y | 0.54 | 0.50 (2) | 0.62 (1) | 1.00 | 0.88 |" in split_markdown([split])
+    with pytest.raises(ValueError, match="'z'"):
+        poi_split(results, "z", "y")

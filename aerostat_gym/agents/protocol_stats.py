@@ -320,7 +320,7 @@ def iqm_ci(scores, confidence: float = DEFAULT_CONFIDENCE, resamples: int = DEFA
     return Interval(interquartile_mean(s), lo, hi, float(confidence), int(s.shape[0]))
 
 
-def _poi_per_task(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def poi_per_task(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """P(X > Y) + 0.5 P(X = Y) per task column: the Mann-Whitney U statistic over n m pairs."""
     gt = (x[:, None, :] > y[None, :, :]).mean(axis=(0, 1))
     eq = (x[:, None, :] == y[None, :, :]).mean(axis=(0, 1))
@@ -347,7 +347,7 @@ def probability_of_improvement(x, y) -> float:
     if xs.shape[1] != ys.shape[1]:
         raise StatsInputError(f"x and y must cover the same tasks, got {xs.shape[1]} and "
                               f"{ys.shape[1]} columns")
-    return float(np.mean(_poi_per_task(xs, ys)))
+    return float(np.mean(poi_per_task(xs, ys)))
 
 
 #: Bootstrap replicates compared at once in :func:`probability_of_improvement_ci` (bounds the

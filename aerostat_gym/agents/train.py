@@ -19,6 +19,11 @@ separate top-level block ``aerostat_gym``:
   are refused),
   designed for the training configuration and the training sensor noise, keeping its own
   state and reset at every episode start (:mod:`aerostat_gym.agents.residual`).
+- ``score_reward: true`` (or ``{floor: F}``): train on the evaluator's score, each episode's
+  rewards divided by the braked winch's return on the same episode
+  (:mod:`aerostat_gym.agents.score_reward`), so that a calm 1 m swing weighs as much as a
+  turbulent high-wind episode, as in the aggregate score. Training only: the saved policy is
+  run as any other.
 
 Algorithms: ``ppo``, ``sac``, ``td3`` (Stable-Baselines3) and ``rppo`` (sb3-contrib's
 RecurrentPPO, an LSTM policy, ``policy: MlpLstmPolicy``).
@@ -69,13 +74,15 @@ from .sb3io import (
     vecnormalize_path,
     write_wrappers,
 )
+from .score_reward import check_score_reward, score_reward_vec_env
 
 ALGOS = ("ppo", "sac", "td3", "rppo")
 #: Keys of a zoo block that configure the run rather than the algorithm's constructor.
 RESERVED = {"n_timesteps", "n_envs", "policy", "normalize", "noise_type", "noise_std",
             "policy_kwargs"}
 PROJECT_BLOCK = "aerostat_gym"
-PROJECT_KEYS = {"eval_freq", "eval_suite", "env_kwargs", "frame_stack", "residual"}
+PROJECT_KEYS = {"eval_freq", "eval_suite", "env_kwargs", "frame_stack", "residual",
+                "score_reward"}
 
 
 class TrainingError(ValueError):
@@ -171,8 +178,10 @@ def residual_base(spec: dict, env_kwargs: dict):
 
 
 def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict | None,
-                      wrappers: dict | None = None, base=None, stats=None):
-    """The SB3 VecEnv over one compiled batch, wrapped in VecMonitor, (with a residual spec in
+                      wrappers: dict | None = None, base=None, stats=None,
+                      score_reward: dict | None = None):
+    """The SB3 VecEnv over one compiled batch, wrapped in VecMonitor (raw returns), (with a
+    validated ``score_reward`` option) the rewards in score units, (with a residual spec in
     ``wrappers``) the residual wrapper on ``base``, (with VecNormalize keyword arguments)
     VecNormalize, its statistics loaded from ``stats`` if that file is given, and (with
     ``frame_stack`` > 1) VecFrameStack."""
@@ -180,6 +189,8 @@ def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict 
 
     wrappers = wrappers or {}
     venv = VecMonitor(sb3_vec_env(n_envs, seed=seed, **env_kwargs))
+    if score_reward is not None:
+        venv = score_reward_vec_env(venv, score_reward)
     if wrappers.get("residual"):
         res = wrappers["residual"]
         venv = residual_vec_env(venv, base,
@@ -244,8 +255,13 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     base = residual_base(wrappers, env_kwargs)
     if resume and not Path(resume).is_file():
         raise TrainingError(f"checkpoint to resume not found: {resume}")
+    try:
+        score = check_score_reward(project.get("score_reward"))
+    except PolicyError as exc:
+        raise TrainingError(str(exc)) from None
     venv = make_training_env(n_envs, seed, env_kwargs, normalize_kwargs(hp), wrappers, base,
-                             stats=vecnormalize_path(Path(resume)) if resume else None)
+                             stats=vecnormalize_path(Path(resume)) if resume else None,
+                             score_reward=score)
     _write_run_files(run, algo, task_id, {task_id: hp, PROJECT_BLOCK: project}, venv, seed,
                      n_envs, timesteps)
     model = _model(algo, hp, venv, seed, run, resume)

@@ -9,8 +9,11 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from ..params import ParameterError, Params, apply_overrides, load_params
 from ..sim import INTEGRATORS
+from ..wind.presets import INTENSITY_CLASSES
 from ..wind.sizing import sized_turbulence
 from . import reward
 from .spaces import check_obs_noise
@@ -65,6 +68,7 @@ class TaskConfig:
 
     wind_speed: tuple = DEFAULT_WIND_RANGE
     turbulence: object = "moderate"
+    turbulence_mix: dict | None = None
     perturbation: object = "mixed"
     tether_length: float | None = None
     n_elements: int | None = None
@@ -106,6 +110,8 @@ class TaskConfig:
             r["turbulence"] = sized_turbulence(r["params"], self.turbulence)
         except (TypeError, ValueError) as exc:
             raise TaskError(f"turbulence: {exc}") from None
+        r["turbulence_mix"] = turbulence_mix(self.turbulence_mix, r["turbulence"],
+                                             self.turbulence)
         r["randomize"] = self._randomize(r["params"])
 
     def _params(self) -> Params:
@@ -137,6 +143,40 @@ class TaskConfig:
     @property
     def params_resolved(self) -> Params:
         return self.resolved["params"]
+
+
+def turbulence_mix(spec, turb, given) -> tuple[tuple[str, ...], np.ndarray] | None:
+    """A per-episode draw of the intensity class, validated (``turb`` the resolved turbulence,
+    ``given`` the ``turbulence`` argument): ``{class: weight}`` over the
+    classes of :data:`aerostat_gym.wind.presets.INTENSITY_CLASSES` (weights finite, >= 0, summing
+    to more than 0; returned as probabilities), or None for the task's one class.
+
+    Every episode then reads the shared bank (unit-variance fields with the configured class's
+    length scales) at the drawn class's sigmas: exact, since the classes of a wind-scaled model
+    differ in sigma alone. So the task's ``turbulence`` must be a wind-scaled class other than
+    "none" (the bank's spectral shape), e.g. ``turbulence="light", turbulence_mix={"none": 0.5,
+    "light": 0.25, "moderate": 0.25}``.
+    """
+    if spec is None:
+        return None
+    if not isinstance(spec, dict) or not spec:
+        raise TaskError(f"turbulence_mix must be a non-empty dict {{class: weight}}, got {spec!r}")
+    unknown = sorted(str(k) for k in set(spec) - set(INTENSITY_CLASSES))
+    if unknown:
+        raise TaskError(f"turbulence_mix: unknown intensity class(es) {unknown}; choose from "
+                        f"{list(INTENSITY_CLASSES)}")
+    for k, w in spec.items():
+        if isinstance(w, bool) or not isinstance(w, (int, float)) or not math.isfinite(w) \
+                or w < 0:
+            raise TaskError(f"turbulence_mix[{k!r}] must be a finite weight >= 0, got {w!r}")
+    total = float(sum(spec.values()))
+    if total <= 0:
+        raise TaskError(f"turbulence_mix weights must not all be zero, got {spec!r}")
+    if turb.is_off or not turb.wind_scaled:
+        raise TaskError("turbulence_mix needs turbulence to be a wind-scaled class other than "
+                        f"'none' (the fields' spectral shape), got turbulence={given!r}")
+    classes = tuple(spec)
+    return classes, np.array([spec[k] / total for k in classes])
 
 
 def _check_range_ends(params: Params, key: str, rel: float) -> None:

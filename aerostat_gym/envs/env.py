@@ -141,6 +141,11 @@ class TetheredAerostatEnv(gym.Env):
       ``winch.max_length`` and its extent follows the longest tether
       (:func:`aerostat_gym.wind.sizing.field_extent`); ``wind.turbulence_reference_height``
       sets the advection height.
+    - ``turbulence_mix=None``: a per-episode draw of the intensity class, ``{class: weight}``
+      (e.g. ``{"none": 0.5, "light": 0.25, "moderate": 0.25}``); each episode reads the bank at
+      its drawn class's sigma (``info["turbulence_class"]``), the rest of the episode as
+      without the mix. ``turbulence`` must then be a wind-scaled class other than "none": the
+      fields keep its length scales, which the classes share.
     - ``perturbation="mixed"``: "none", "displacement", "gust", "mixed" or a dict with keys
       swing [m], lateral [m], pitch [rad], gust_probability, gust_amplitude [m/s] (low, high),
       gust_duration [s] (low, high), gust_onset [s] (low, high).
@@ -191,6 +196,8 @@ class TetheredAerostatEnv(gym.Env):
     - v0 (aerostat-gym 0.5; dynamics, observation and reward unchanged, every 0.4 evaluation
       reproduced): ``obs_noise`` is refused unless a finite real number >= 0 (``True`` was taken
       as 1.0).
+    - v0 (aerostat-gym 0.6; dynamics, observation and reward unchanged): ``turbulence_mix``, a
+      per-episode intensity-class draw (absent, every episode is as in 0.5).
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}

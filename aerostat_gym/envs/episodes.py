@@ -164,8 +164,14 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
     wp = mean_wind(params.wind, U)
     ua = set_advection(wp, cfg.reference_height, cfg.min_advection_speed)
     field_index, offset = _field(cfg, bank_shape, ua, wp, rng)
-    sigmas = _intensity(cfg, wp)
     x0, info = _perturb(x_trim, params, pert, wp, ua, rng)
+    mix = task.resolved.get("turbulence_mix")
+    if mix is not None:  # drawn last: the rest of the episode is the single-class task's
+        cfg = cfg.replace(intensity=mix[0][int(rng.choice(len(mix[0]), p=mix[1]))])
+        info["turbulence_class"] = cfg.intensity
+        if cfg.is_off:  # calm air: the field is set (the bank's grid) and read at zero scale
+            set_field_scale(wp, (0.0, 0.0, 0.0))
+    sigmas = _intensity(cfg, wp)
     info.update({"wind_speed": U, "field_index": field_index, "field_offset_m": offset,
                  "turbulence_sigma_m_s": sigmas})
     return Episode(x0, x_trim, float(tension), pack_params(params), wp, field_index, U, params,

@@ -1,0 +1,48 @@
+"""The aggregate's probability of improvement split into calm and turbulent cells, with the most
+a policy could reach by winning every calm cell (:mod:`aerostat_gym.agents.poi_split`).
+
+Reads the ``report.json`` of ``aerostat-gym evaluate`` runs on one suite (the normalising
+passive policy among them) and prints, for every X of ``--x`` against every Y of ``--y``, P(X > Y)
+over all cells, over the calm and the turbulent cells, the paired win rate in the turbulent
+cells, and the bound. Usage::
+
+    aerostat-gym evaluate --suite report --out runs/split --no-plots --policy passive \\
+        --policy modal --policy modal_lqg_shaped --policy shipped
+    PYTHONPATH=. python scripts/poi_split.py runs/split/report.json \\
+        --x ppo_tethered_aerostat modal_lqg_shaped --y modal modal_lqg_shaped \\
+        [--markdown docs/figures/poi_split.md --json docs/figures/poi_split.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from aerostat_gym.agents.poi_split import poi_split, split_markdown
+from aerostat_gym.agents.protocol import dumps
+from aerostat_gym.agents.report import load_results
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("report_json", nargs="+", help="report.json of evaluate runs on one suite")
+    ap.add_argument("--x", nargs="+", required=True, help="labels of the improving policies")
+    ap.add_argument("--y", nargs="+", required=True, help="labels of the policies compared to")
+    ap.add_argument("--markdown", default=None, help="write the table here")
+    ap.add_argument("--json", default=None, help="write the rows here")
+    args = ap.parse_args(argv)
+    try:
+        results = list(load_results(args.report_json, args.x + args.y).values())
+        rows = [poi_split(results, x, y) for x in args.x for y in args.y if x != y]
+    except ValueError as err:
+        raise SystemExit(str(err)) from None
+    md = split_markdown(rows)
+    print(md)
+    if args.markdown:
+        Path(args.markdown).write_text(md)
+    if args.json:
+        Path(args.json).write_text(dumps(rows))
+
+
+if __name__ == "__main__":
+    main()
