@@ -11,6 +11,8 @@ from aerostat_gym.agents.metrics import (
     response_metrics,
     settling_time,
 )
+from aerostat_gym.agents.pitch_check import linear_pitch_check
+from aerostat_gym.params import load_params
 
 
 def damped(t, zeta, period, amplitude=2.0, offset=1.3, phase=0.7):
@@ -147,3 +149,18 @@ def test_report_json_carries_intervals_per_cell():
     assert ten["rms_x_m_ci"] == [want.low, want.high]
     assert want.low < ten["rms_x_m"] < want.high
     assert cells[1]["rms_x_m_ci"] == [12.0, 12.0] and "ended" not in ten and "seed" not in ten
+
+
+def test_pitch_fit_reads_the_blend_of_pitching_and_axial_spring():
+    """The protocol's pitch fit on a 1 m / 0.005 rad start at 10 m/s (``recover_small``): on the
+    nonlinear braked run it finds the value it finds on the linear braked response from the same
+    start (measured 0.319 and 0.317: at this amplitude the simulator is its linearization), and
+    both lie above the linear pitching mode's damping ratio (0.262 at 2.43 s, `aerostat-gym
+    stability`) by the blend with the axial-spring mode (0.155 at 3.27 s): measured +21 %,
+    asserted above +10 %. The README's reading of the pitch verdicts rests on this."""
+    r = linear_pitch_check(load_params(None), 10.0, "recover_small")
+    assert r["nonlinear_fit_zeta"] == pytest.approx(r["linear_fit_zeta"], abs=0.01)
+    assert r["pitching_zeta"] == pytest.approx(0.262, abs=0.002)
+    assert r["pitching_period_s"] == pytest.approx(2.43, abs=0.01)
+    assert r["axial_spring_period_s"] == pytest.approx(3.27, abs=0.01)
+    assert r["linear_fit_zeta"] > 1.10 * r["pitching_zeta"]
