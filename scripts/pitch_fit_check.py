@@ -11,10 +11,9 @@ from the scenario's start. Usage::
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from aerostat_gym.agents.pitch_check import check_markdown, linear_pitch_check
-from aerostat_gym.agents.protocol import dumps
+from aerostat_gym.agents.report import emit_table
 from aerostat_gym.params import load_params
 
 
@@ -28,12 +27,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     params = load_params(args.config)
     rows = [linear_pitch_check(params, u, s) for s in args.scenarios for u in args.speeds]
-    md = check_markdown(rows)
-    print(md)
-    if args.markdown:
-        Path(args.markdown).write_text(md)
-    if args.json:
-        Path(args.json).write_text(dumps(rows))
+    emit_table(check_markdown(rows), rows, args.markdown, args.json)
 
 
 if __name__ == "__main__":

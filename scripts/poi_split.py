@@ -16,11 +16,9 @@ cells, and the bound. Usage::
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from aerostat_gym.agents.poi_split import poi_split, split_markdown
-from aerostat_gym.agents.protocol import dumps
-from aerostat_gym.agents.report import load_results
+from aerostat_gym.agents.report import emit_table, load_results
 
 
 def main(argv=None) -> None:
@@ -36,12 +34,7 @@ def main(argv=None) -> None:
         rows = [poi_split(results, x, y) for x in args.x for y in args.y if x != y]
     except ValueError as err:
         raise SystemExit(str(err)) from None
-    md = split_markdown(rows)
-    print(md)
-    if args.markdown:
-        Path(args.markdown).write_text(md)
-    if args.json:
-        Path(args.json).write_text(dumps(rows))
+    emit_table(split_markdown(rows), rows, args.markdown, args.json)
 
 
 if __name__ == "__main__":

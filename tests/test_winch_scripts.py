@@ -4,6 +4,7 @@ figures (slow). Every assertion states its tolerance.
 """
 
 import importlib.util
+import json
 from pathlib import Path
 
 import pytest
@@ -84,3 +85,25 @@ def test_frontier_point_reproduces():
     assert row["zeta"] == pytest.approx(0.545, abs=0.005)
     assert row["zeta_drift"] == pytest.approx(0.611, abs=0.005)
     assert row["peak_reel_speed_m_s"] == pytest.approx(0.715, abs=0.005)
+
+
+def test_poi_split_script_writes_its_table(tmp_path, capsys):
+    """scripts/poi_split.py on a constructed two-cell report prints and writes the table and
+    rows the library gives (a calm cell won outright, a tied turbulent cell: P 0.75, and so the
+    bound); an unknown label is one line naming it."""
+    def res(label, calm, gusty):
+        ep = {"wind_speed": 10.0, "seed": 1, "return": calm}
+        return {"label": label, "suite": "report", "score": 0.0, "scenarios": {
+            "recover": {"episodes": [ep, {**ep, "seed": 2}]},
+            "gusty": {"episodes": [{**ep, "return": gusty}, {**ep, "seed": 2, "return": gusty}]}}}
+
+    report = tmp_path / "report.json"
+    report.write_text(json.dumps([res("passive", -2.0, -20.0), res("a", -1.0, -20.0)]))
+    split = load("poi_split")
+    split.main([str(report), "--x", "a", "--y", "passive", "--markdown",
+                str(tmp_path / "s.md"), "--json", str(tmp_path / "s.json")])
+    row = json.loads((tmp_path / "s.json").read_text())[0]
+    assert (row["calm"], row["turbulent"], row["p"], row["bound"]) == (1.0, 0.5, 0.75, 0.75)
+    assert (tmp_path / "s.md").read_text() in capsys.readouterr().out
+    with pytest.raises(SystemExit, match="'zz'"):
+        split.main([str(report), "--x", "zz", "--y", "passive"])

@@ -363,3 +363,13 @@ def _progress(items, enabled: bool, desc: str):
     except ImportError:  # pragma: no cover
         return items
     return tqdm(items, desc=desc)
+
+
+def emit_table(markdown: str, rows, markdown_path=None, json_path=None) -> None:
+    """Print a study's Markdown table and write it (and its rows as JSON, NaN as null) where
+    asked: the common tail of the study scripts."""
+    print(markdown)
+    if markdown_path:
+        Path(markdown_path).write_text(markdown)
+    if json_path:
+        Path(json_path).write_text(proto_mod.dumps(rows))
