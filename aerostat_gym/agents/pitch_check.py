@@ -24,13 +24,16 @@ from ..analysis.trim import find_equilibrium
 from ..envs.config import DEFAULT_WIND_RANGE
 from ..envs.vector import TetheredAerostatVectorEnv
 from .evaluate import SCENARIOS, run_scenario
-from .metrics import fit_damped_sinusoid, response_metrics
+from .metrics import _failed, fit_damped_sinusoid, response_metrics
 from .metrics_modes import fit_modes, nearest_mode
 from .policies import PassivePolicy, load_policy
 from .protocol_stats import paired_difference_ci
 
 #: Longitudinal modes whose damping ratio is reported beside the fit.
 REPORTED_MODES = ("pitching", "axial spring")
+#: Start of the fast modes away from the linear ones, to show that the fit does not return its
+#: start: (damping-ratio factor, pitching-period factor, axial-spring-period factor).
+AWAY_START = (0.5, 1.1, 0.9)
 
 
 def scenario_start(params, wind_speed: float, scenario: str) -> np.ndarray:
@@ -82,17 +85,17 @@ def linear_pitch_check(params, wind_speed: float, scenario: str = "recover",
 
 
 def _pitching_fit(t, x, pitch, modal, away: bool = False):
-    """The pitching mode of a pitch history by :func:`fit_modes` (pendulum from the along-wind
-    displacement, pitching and axial spring from the linear ``modal`` analysis; ``away``: start
-    the two fast modes at half their damping ratio and 10 % off their period, to show the fit
-    does not merely return its start)."""
+    """The pitching mode of a pitch history by :func:`fit_modes` (pendulum started from the
+    along-wind displacement's fit, pitching and axial spring from the linear ``modal`` analysis,
+    or from :data:`AWAY_START` off them with ``away``)."""
     pend = fit_damped_sinusoid(t, x)
     pit, ax = modal.find("long", "pitching"), modal.find("long", "axial spring")
     if not (pend.ok and pit and ax):
-        return nearest_mode([], 0.0)
-    f = (0.5, 1.1, 0.9) if away else (1.0, 1.0, 1.0)
-    fits = fit_modes(t, pitch, [(pend.zeta, pend.period), (f[0] * pit.zeta, f[1] * pit.period),
-                                (f[0] * ax.zeta, f[2] * ax.period)])
+        return _failed("no pendulum fit, or no linear pitching or axial-spring mode")
+    zeta_f, pit_f, ax_f = AWAY_START if away else (1.0, 1.0, 1.0)
+    fits = fit_modes(t, pitch, [(pend.zeta, pend.period),
+                                (zeta_f * pit.zeta, pit_f * pit.period),
+                                (zeta_f * ax.zeta, ax_f * ax.period)])
     return nearest_mode(fits[1:], pit.period)
 
 
