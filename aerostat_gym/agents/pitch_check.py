@@ -24,6 +24,7 @@ from ..analysis.trim import find_equilibrium
 from ..envs.config import DEFAULT_WIND_RANGE
 from ..envs.vector import TetheredAerostatVectorEnv
 from .evaluate import SCENARIOS, run_scenario
+from .frontier import linear_response
 from .metrics import _failed, fit_damped_sinusoid, response_metrics
 from .metrics_modes import fit_modes, nearest_mode
 from .policies import PassivePolicy, load_policy
@@ -57,11 +58,9 @@ def linear_pitch_check(params, wind_speed: float, scenario: str = "recover",
     lin, lay = modal.linear, modal.linear.layout
     mech = lay.n_mechanical
     steps = int(round(SCENARIOS[scenario].duration / dt))
-    Ad = sla.expm(lin.A * dt)  # braked: the paid-out length is fixed
-    X = np.empty((steps + 1, mech))
-    X[0] = scenario_start(params, wind_speed, scenario)[:mech]
-    for k in range(steps):
-        X[k + 1] = Ad @ X[k]
+    Ad = sla.expm(lin.A * dt)  # braked: the paid-out length is fixed, no set-point
+    X, _ = linear_response(Ad, np.zeros(mech), scenario_start(params, wind_speed, scenario)[:mech],
+                           steps)
     t = np.arange(steps + 1) * dt
     zero = np.zeros(steps + 1)
     fit = response_metrics(t, X[:, lay.cm_pos.start], X[:, lay.euler.start + 1], zero, zero)

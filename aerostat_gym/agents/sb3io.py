@@ -69,15 +69,21 @@ def wrappers_path(model_path: Path) -> Path:
     return model_path.with_name(model_path.stem + WRAPPERS_SUFFIX)
 
 
+def find_in_chain(venv, cls):
+    """The first environment of type ``cls`` down a wrapper chain (each wrapper's ``venv``;
+    None if there is none)."""
+    while venv is not None:
+        if isinstance(venv, cls):
+            return venv
+        venv = getattr(venv, "venv", None)
+    return None
+
+
 def find_vecnormalize(venv):
     """The VecNormalize in a wrapper chain (None if there is none)."""
     from stable_baselines3.common.vec_env import VecNormalize
 
-    while venv is not None:
-        if isinstance(venv, VecNormalize):
-            return venv
-        venv = getattr(venv, "venv", None)
-    return None
+    return find_in_chain(venv, VecNormalize)
 
 
 def save_model(model, path: Path, wrappers: dict | None = None) -> None:

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..envs.reference import BrakedReference
 from ..envs.vector import TetheredAerostatVectorEnv
-from .sb3io import PolicyError
+from .sb3io import PolicyError, find_in_chain
 
 #: Default floor of the reference return [return units]: about the braked winch's return of a
 #: 1 m calm along-wind swing over a 120 s episode (measured on the baseline: -1.40 / -0.92 /
@@ -54,10 +54,9 @@ def check_score_reward(spec) -> dict | None:
 def native_vector_env(venv):
     """The package's native vector environment under a chain of SB3 wrappers (it holds the
     batch); a PolicyError if the chain has none."""
-    while venv is not None:
-        if isinstance(venv, TetheredAerostatVectorEnv):
-            return venv
-        venv = getattr(venv, "venv", None)
+    native = find_in_chain(venv, TetheredAerostatVectorEnv)
+    if native is not None:
+        return native
     raise PolicyError("score_reward needs the package's native vector environment "
                       "(aerostat_gym.envs.sb3.sb3_vec_env)")
 
