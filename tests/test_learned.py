@@ -39,6 +39,13 @@ VARIANTS = {
                      {"residual": {"base": "lqg", "scale": 0.3}}, 1024),
     "residual-modal-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
                            {"residual": {"base": "modal_lqg", "scale": 0.1}}, 1024),
+    "estimate-residual-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
+                              {"residual": {"base": "modal_lqg", "scale": 0.1,
+                                            "observe_estimate": True}}, 1024),
+    "asymmetric-estimate-residual-ppo": (
+        "ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
+        {"residual": {"base": "modal_lqg", "scale": 0.1, "observe_estimate": True},
+         "asymmetric_critic": True}, 1024),
     "stack-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
                   {"frame_stack": 4}, 1024),
     "score-mix-residual-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
@@ -85,7 +92,10 @@ def test_smoke_training_is_deterministic_and_reloads(tmp_path, variant):
     returns = []
     for path in final:
         policy = load_policy(str(path))
-        assert isinstance(policy, SB3Policy) and policy.obs_dim == N_OBS
+        # an asymmetric critic's training observation is the full layout (its actor reads the
+        # standard channels of it); every other variant's the standard one
+        full = VARIANTS[variant][2].get("asymmetric_critic", False)
+        assert isinstance(policy, SB3Policy) and (policy.obs_dim > N_OBS) == full
         ep = run_scenario(policy, "recover", [10.0], [0])
         assert np.isfinite(ep.returns).all()
         returns.append(float(ep.returns[0]))
@@ -100,7 +110,8 @@ def test_smoke_training_is_deterministic_and_reloads(tmp_path, variant):
     assert read_wrappers(runs[0] / "checkpoints" / f"{algo}_1000_steps.zip") == meta
 
 
-@pytest.mark.parametrize("variant", ["stack-ppo", "residual-ppo", "rppo"])
+@pytest.mark.parametrize("variant", ["stack-ppo", "residual-ppo", "estimate-residual-ppo",
+                                     "rppo"])
 def test_reloaded_policy_scores_as_in_training(tmp_path, variant):
     """The suite score of the reloaded final model equals the last in-training evaluation
     (the same model through the training run's VecNormalize, stack and base); exactly for the
@@ -150,17 +161,24 @@ def test_policy_frame_stack_matches_vecframestack():
     venv.close()
 
 
-@pytest.mark.parametrize("deadband, lowpass", [(0.0, 0.0), (0.1, 0.0), (0.1, 1.0)])
-def test_residual_evaluation_matches_training_wrapper(deadband, lowpass):
+@pytest.mark.parametrize("deadband, lowpass, observe", [(0.0, 0.0, False), (0.1, 0.0, False),
+                                                         (0.1, 1.0, False), (0.1, 1.0, True)])
+def test_residual_evaluation_matches_training_wrapper(deadband, lowpass, observe):
     """The action the residual wrapper sends the environment in training equals SB3Policy's
     residual action for the same policy output, across episode resets, with and without a
     deadband (which, at 0.1 against residual commands of up to 0.3, zeroes some of them) and a
-    command low-pass (whose state both must reset at each episode start)."""
+    command low-pass (whose state both must reset at each episode start). With
+    ``observe_estimate`` the observation the model reads is the wrapper's, bit for bit: the
+    environment's channels, then the base's estimate features; an ended episode's terminal
+    observation carries the features of the estimate after it."""
     env_kwargs = {**SMOKE_ENV, "max_episode_steps": 7}
-    spec = wrapper_spec({"residual": {"base": "lqg", "scale": 0.3, "deadband": deadband,
-                                      "lowpass": lowpass}}, env_kwargs)
+    res = {"base": "lqg", "scale": 0.3, "deadband": deadband, "lowpass": lowpass}
+    spec = wrapper_spec({"residual": {**res, "observe_estimate": True} if observe else res},
+                        env_kwargs)
     base = residual_base(spec, env_kwargs)
     venv = make_training_env(2, 0, env_kwargs, None, spec, base)
+    width = N_OBS + (base.n_features if observe else 0)
+    assert venv.observation_space.shape == (width,)
     inner = venv.venv
     sent = []
     original = inner.step_async
@@ -172,23 +190,56 @@ def test_residual_evaluation_matches_training_wrapper(deadband, lowpass):
         action = np.zeros((2, 1), np.float32)
 
         def predict(self, obs, deterministic=True):
+            self.seen = obs.copy()
             return self.action, None
 
     model = Model()
-    policy = SB3Policy(model, None,
-                       residual=(load_policy("lqg", obs_noise=0.01),
-                                 CommandShaper(0.3, deadband, lowpass, 0.2)))
+    twin = load_policy("lqg", obs_noise=0.01)  # the evaluation's own base, built the same way
+    policy = SB3Policy(model, None, residual=(twin, CommandShaper(0.3, deadband, lowpass, 0.2)),
+                       observe_estimate=observe)
+    assert policy.obs_dim == N_OBS
     state, start, rng, ends = None, np.ones(2, bool), np.random.default_rng(1), 0
     for _ in range(20):
         model.action = rng.uniform(-1.5, 1.5, (2, 1)).astype(np.float32)
         expected, state = policy.predict(obs[:, :N_OBS], state=state, episode_start=start)
-        obs, _, dones, _ = venv.step(model.action)
+        np.testing.assert_array_equal(model.seen, obs)
+        last_state = state["base"]
+        obs, _, dones, infos = venv.step(model.action)
         np.testing.assert_array_equal(sent[-1], expected)
+        for i in np.flatnonzero(dones):
+            terminal = infos[i]["terminal_observation"]
+            assert terminal.shape == (width,)
+            if observe:  # the base's step on the last observation, from its state before it
+                _, after = twin.predict(terminal[None, :N_OBS], state=last_state[i:i + 1],
+                                        episode_start=np.zeros(1, bool))
+                np.testing.assert_array_equal(terminal[N_OBS:],
+                                              twin.estimate_features(after)[0])
         start, ends = dones, ends + int(dones.sum())
     assert ends >= 2
     zeros = sum(int(np.sum(a == 0.0)) for a in sent)
     assert (zeros > 0) == (deadband > 0.0)
     venv.close()
+
+
+def test_observe_estimate_is_validated():
+    """observe_estimate needs a Kalman-filter base and a boolean; a model whose input width does
+    not fit is refused when it is wrapped."""
+    from aerostat_gym.agents.residual import check_residual
+
+    assert check_residual({"base": "modal_lqg", "observe_estimate": True})["observe_estimate"]
+    assert "observe_estimate" not in check_residual({"base": "lqg", "observe_estimate": False})
+    with pytest.raises(PolicyError, match="Kalman filter"):
+        check_residual({"base": "tension", "observe_estimate": True})
+    with pytest.raises(PolicyError, match="true or false"):
+        check_residual({"base": "lqg", "observe_estimate": "yes"})
+
+    class Model:
+        from gymnasium.spaces import Box
+        observation_space = Box(-1.0, 1.0, (N_OBS,))
+
+    base = load_policy("lqg", obs_noise=0.01)
+    with pytest.raises(PolicyError, match="reads 19 channels per frame: fewer than the 19 standard channels and"):
+        SB3Policy(Model(), None, residual=(base, CommandShaper(0.1)), observe_estimate=True)
 
 
 def test_residual_deadband_closed_form():
@@ -304,6 +355,46 @@ def test_residual_refuses_privileged_bases(base):
         wrapper_spec({"residual": {"base": "telepathy"}}, {})
     with pytest.raises(TrainingError, match="frame_stack"):
         wrapper_spec({"frame_stack": 0}, {})
+
+
+def test_asymmetric_actor_reads_only_its_channels(tmp_path):
+    """An asymmetric actor-critic's action depends on the standard channels and the base's
+    estimate features only: changing every privileged channel of the observation leaves the
+    action distribution bit-identical while it moves the value; changing a standard channel
+    moves the action. The option is validated at the door."""
+    import torch
+
+    algo, config = _config(tmp_path, "asymmetric-estimate-residual-ppo")
+    run = train(algo, config, timesteps=256, seed=0, run_dir=tmp_path / "r", progress_bar=False,
+                threads=1, eval_freq=10**9)
+    policy = load_policy(str(run / f"{algo}_final.zip"))
+    net = policy.model.policy
+    width = policy.model.observation_space.shape[0]
+    channels = net.actor_channels
+    assert channels == list(range(N_OBS)) + list(range(width - 10, width))
+    rng = np.random.default_rng(0)
+    obs = torch.as_tensor(rng.normal(size=(8, width)), dtype=torch.float32)
+    privileged = obs.clone()
+    privileged[:, N_OBS:width - 10] = torch.as_tensor(rng.normal(size=(8, width - 10 - N_OBS)),
+                                                      dtype=torch.float32)
+    sensed = obs.clone()
+    sensed[:, 0] += 1.0
+    with torch.no_grad():
+        mean = [net.get_distribution(o).distribution.mean for o in (obs, privileged, sensed)]
+        value = [net.predict_values(o) for o in (obs, privileged)]
+    assert torch.equal(mean[0], mean[1]) and not torch.equal(mean[0], mean[2])
+    assert not torch.equal(value[0], value[1])
+    from aerostat_gym.agents.train import check_asymmetric
+
+    assert check_asymmetric(True, "ppo", "MlpPolicy", {}) is True
+    with pytest.raises(TrainingError, match="true or false"):
+        check_asymmetric("yes", "ppo", "MlpPolicy", {})
+    with pytest.raises(TrainingError, match="option of PPO's MlpPolicy"):
+        check_asymmetric(True, "sac", "MlpPolicy", {})
+    with pytest.raises(TrainingError, match="option of PPO's MlpPolicy"):
+        check_asymmetric(True, "ppo", "MlpLstmPolicy", {})
+    with pytest.raises(TrainingError, match="frame_stack"):
+        check_asymmetric(True, "ppo", "MlpPolicy", {"frame_stack": 4})
 
 
 def test_residual_model_needs_its_base(tmp_path):

@@ -57,6 +57,9 @@ from .modal import design_modal
 #: Standard observation channels the filter uses (name -> index), all longitudinal.
 MEASURED = {"dx": 0, "dz": 2, "vx": 3, "vz": 5, "dpitch": 7, "q": 10, "dtension": 13,
             "dlength": 14, "reel_speed": 15}
+#: The features :meth:`LQGPolicy.estimate_features` gives: each measured channel as the
+#: filter's estimate reconstructs it, then the set-point just sent.
+ESTIMATE_FEATURES = tuple(f"{name}_estimate" for name in MEASURED) + ("base_command",)
 #: Channel of the measured along-wind air velocity (the wind-speed estimate for the schedule).
 WIND_CHANNEL = 16
 #: Time constant of the wind-speed estimate [s].
@@ -310,17 +313,19 @@ class LQGSchedule:
                        for name in ("Ad", "Bd", "C", "L", "K")}
         self.tables["K_integral"] = np.array([d.K_integral for d in designs])
 
-    def lookup(self, U: np.ndarray) -> dict:
-        """Every table at the speeds U (N,), linear in U between the design speeds."""
+    def lookup(self, U: np.ndarray, names=None) -> dict:
+        """The tables ``names`` (default every one) at the speeds U (N,), linear in U between
+        the design speeds."""
         s = self.speeds
         U = np.asarray(U, float)
+        tables = {k: self.tables[k] for k in (names or self.tables)}
         if s.size == 1:
-            return {k: np.broadcast_to(v[0], U.shape + v.shape[1:]) for k, v in self.tables.items()}
+            return {k: np.broadcast_to(v[0], U.shape + v.shape[1:]) for k, v in tables.items()}
         Uc = np.clip(U, s[0], s[-1])
         i = np.clip(np.searchsorted(s, Uc, side="right") - 1, 0, s.size - 2)
         w = (Uc - s[i]) / (s[i + 1] - s[i])
         out = {}
-        for k, v in self.tables.items():
+        for k, v in tables.items():
             ww = w.reshape(w.shape + (1,) * (v.ndim - 1))
             out[k] = (1.0 - ww) * v[i] + ww * v[i + 1]
         return out
@@ -353,6 +358,7 @@ class LQGPolicy:
     """
 
     obs_dim = N_OBS
+    n_features = len(ESTIMATE_FEATURES)
 
     def __init__(self, params: Params, dt: float = 0.2, obs_noise: float = 0.0,
                  schedule: LQGSchedule | None = None, gains: str = "lqr"):
@@ -411,6 +417,18 @@ class LQGPolicy:
         S_next = np.column_stack([x_hat, np.where(wind_up, z, z + dz), U, v_cmd])
         actions = np.clip(v_cmd / self.max_speed, -1.0, 1.0).astype(np.float32)[:, None]
         return (actions[0] if single else actions), S_next
+
+    def estimate_features(self, state) -> np.ndarray:
+        """What the filter knows after a step, for a learned residual to read
+        (:data:`ESTIMATE_FEATURES`): the measured channels reconstructed from the estimate,
+        C(U) x^, in the observation's scaled units (the sensor noise filtered out, the
+        pendulum's phase in the displacement and velocity pair), and the set-point just sent
+        as a fraction of the winch's top speed; (N, 10) float32 from the (N, n + 3)
+        ``state`` that :meth:`predict` returned."""
+        S = np.asarray(state, dtype=float)
+        C = self.schedule.lookup(S[:, self.n + 1], ("C",))["C"]
+        y_hat = np.einsum("nij,nj->ni", C, S[:, :self.n]) / self.scale
+        return np.column_stack([y_hat, S[:, -1] / self.max_speed]).astype(np.float32)
 
     def predicted_modes(self, wind_speed: float) -> dict:
         """The design nearest ``wind_speed``: LQR modes and the slowest estimator pole."""

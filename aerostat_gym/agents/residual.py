@@ -31,7 +31,10 @@ from .sb3io import CommandShaper, PolicyError, check_lowpass_on
 #: Baselines that read the standard observation only, allowed as residual bases.
 RESIDUAL_BASES = ("lqg", "modal_lqg", "tension")
 #: Keys of a residual block.
-RESIDUAL_KEYS = frozenset({"base", "scale", "deadband", "lowpass", "lowpass_on"})
+RESIDUAL_KEYS = frozenset({"base", "scale", "deadband", "lowpass", "lowpass_on",
+                           "observe_estimate"})
+#: Bases with a Kalman filter, whose estimate the learned residual can be given to read.
+ESTIMATE_BASES = ("lqg", "modal_lqg")
 #: Baselines that read the privileged full state: refused.
 PRIVILEGED_BASES = ("lqr", "modal")
 
@@ -46,7 +49,8 @@ def check_residual(spec) -> dict:
     PolicyError otherwise); the optional keys are returned only when they are set."""
     if not isinstance(spec, dict) or set(spec) - RESIDUAL_KEYS or "base" not in spec:
         raise PolicyError("residual must be a mapping {base: NAME, scale: S[, deadband: D]"
-                          f"[, lowpass: TAU][, lowpass_on: sum|base]}}, got {spec!r}")
+                          "[, lowpass: TAU][, lowpass_on: sum|base][, observe_estimate: "
+                          f"true]}}, got {spec!r}")
     base = spec["base"]
     if base in PRIVILEGED_BASES:
         raise PolicyError(f"residual base {base!r} reads the privileged full state: learned and "
@@ -65,7 +69,20 @@ def check_residual(spec) -> dict:
         out["lowpass"] = check_lowpass(spec["lowpass"])
     if "lowpass_on" in spec:
         out["lowpass_on"] = check_lowpass_on(spec["lowpass_on"])
+    if spec.get("observe_estimate", False) is not False:
+        out["observe_estimate"] = check_observe_estimate(spec["observe_estimate"], base)
     return out
+
+
+def check_observe_estimate(flag, base: str) -> bool:
+    """``observe_estimate: true``: the policy also reads the base's filter estimate, which only
+    the Kalman-filter bases (:data:`ESTIMATE_BASES`) have."""
+    if not isinstance(flag, bool):
+        raise PolicyError(f"residual observe_estimate must be true or false, got {flag!r}")
+    if base not in ESTIMATE_BASES:
+        raise PolicyError(f"residual observe_estimate needs a base with a Kalman filter "
+                          f"{ESTIMATE_BASES}; {base!r} has none")
+    return True
 
 
 def check_lowpass(tau) -> float:
@@ -92,36 +109,69 @@ def check_deadband(d) -> float:
     return float(d)
 
 
-def residual_vec_env(venv, base, shaper: CommandShaper):
+def residual_vec_env(venv, base, shaper: CommandShaper, observe_estimate: bool = False):
     """``venv`` (a raw SB3 VecEnv giving the standard observation first) with the actions
-    made residual on ``base`` (a policy with the SB3 ``predict`` signature) through ``shaper``."""
+    made residual on ``base`` (a policy with the SB3 ``predict`` signature) through ``shaper``;
+    with ``observe_estimate`` the observation also carries the base's filter estimate
+    (:meth:`aerostat_gym.agents.lqg.LQGPolicy.estimate_features`) after the environment's
+    channels."""
+    from gymnasium import spaces
     from stable_baselines3.common.vec_env import VecEnvWrapper
 
     class ResidualVecEnv(VecEnvWrapper):
-        """Adds the base policy's action: env action = shaper(base, action)."""
+        """Adds the base policy's action: env action = shaper(base, action). The base reads
+        each observation as it arrives, so its command (and estimate) for that step is ready
+        when the policy acts on it."""
 
         def __init__(self):
-            super().__init__(venv)
+            space = venv.observation_space
+            if observe_estimate:
+                n = base.n_features
+                space = spaces.Box(np.append(space.low, np.full(n, -np.inf, np.float32)),
+                                   np.append(space.high, np.full(n, np.inf, np.float32)),
+                                   dtype=np.float32)
+            super().__init__(venv, observation_space=space)
             self.base, self.shaper = base, shaper
-            self._obs, self._state, self._filter = None, None, None
+            self._command, self._state, self._filter = None, None, None
             self._start = np.ones(self.num_envs, bool)
+
+        def _read(self, obs):
+            """The base's command for ``obs``; the observation the policy reads."""
+            self._command, self._state = self.base.predict(
+                obs[:, :N_OBS], state=self._state, episode_start=self._start,
+                deterministic=True)
+            if not observe_estimate:
+                return obs
+            return np.hstack([obs, self.base.estimate_features(self._state)])
 
         def reset(self):
-            self._obs = self.venv.reset()
             self._state, self._filter = None, None
             self._start = np.ones(self.num_envs, bool)
-            return self._obs
+            return self._read(self.venv.reset())
 
         def step_async(self, actions):
-            b, self._state = self.base.predict(self._obs[:, :N_OBS], state=self._state,
-                                               episode_start=self._start, deterministic=True)
-            cmd, self._filter = self.shaper(b, actions, self._filter, self._start)
+            cmd, self._filter = self.shaper(self._command, actions, self._filter, self._start)
             self.venv.step_async(cmd)
 
         def step_wait(self):
             obs, rew, dones, infos = self.venv.step_wait()
-            self._obs, self._start = obs, np.asarray(dones, bool).copy()
-            return obs, rew, dones, infos
+            if observe_estimate:
+                self._terminal_features(np.flatnonzero(dones), infos)
+            self._start = np.asarray(dones, bool).copy()
+            return self._read(obs), rew, dones, infos
+
+        def _terminal_features(self, ended, infos):
+            """The estimate after each ended episode's last observation (what the value of a
+            truncated episode is bootstrapped from), on a copy of the base's state."""
+            ended = [i for i in ended if "terminal_observation" in infos[i]]
+            if not ended:
+                return
+            last = np.array([infos[i]["terminal_observation"] for i in ended])
+            _, state = self.base.predict(last[:, :N_OBS], state=self._state[ended],
+                                         episode_start=self._start[ended], deterministic=True)
+            features = self.base.estimate_features(state)
+            for k, i in enumerate(ended):
+                infos[i]["terminal_observation"] = np.append(last[k], features[k])
 
     return ResidualVecEnv()
 

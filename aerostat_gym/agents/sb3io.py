@@ -128,26 +128,37 @@ class SB3Policy:
     times the shaper's scale to the base policy's (which reads the raw observation and keeps its
     own state), clipped to [-1, 1], low-passed and deadbanded as in training. The state passed
     back and forth is then a dict of the recurrent model's state, the stack, the base policy's
-    state and the command filter's; ``episode_start`` resets all four.
+    state and the command filter's; ``episode_start`` resets all four. With
+    ``observe_estimate`` the model also reads the base's filter estimate
+    (``base.estimate_features``), appended to the raw observation before normalisation, as
+    the training wrapper does (:func:`aerostat_gym.agents.residual.residual_vec_env`).
     """
 
-    def __init__(self, model, vecnormalize=None, frame_stack: int = 1, residual=None):
+    def __init__(self, model, vecnormalize=None, frame_stack: int = 1, residual=None,
+                 observe_estimate: bool = False):
         from stable_baselines3.common.vec_env import VecNormalize
 
         self.model = model
         self.norm = vecnormalize if isinstance(vecnormalize, VecNormalize) else None
         self.frame_stack = int(frame_stack)
         self.residual = residual
+        self.observe_estimate = bool(observe_estimate) and residual is not None
         self.recurrent = _is_recurrent(model)
-        self.obs_dim = int(model.observation_space.shape[0]) // self.frame_stack
+        frame = int(model.observation_space.shape[0]) // self.frame_stack
+        # the environment's channels; the base's estimate features follow them
+        self.obs_dim = frame - (residual[0].n_features if self.observe_estimate else 0)
+        if self.obs_dim < N_OBS:
+            raise PolicyError(f"the model reads {frame} channels per frame: fewer than the "
+                              f"{N_OBS} standard channels"
+                              + (f" and the base's {residual[0].n_features} estimate features"
+                                 if self.observe_estimate else ""))
         self.plain = self.frame_stack == 1 and residual is None and not self.recurrent
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs, single = as_batch(observation)
-        raw = obs
-        if self.norm is not None:
-            obs = self.norm.normalize_obs(obs)
         if self.plain:
+            if self.norm is not None:
+                obs = self.norm.normalize_obs(obs)
             a, _ = self.model.predict(obs, deterministic=deterministic)
             return to_actions(np.asarray(a).reshape(-1), single), state
         n = len(obs)
@@ -155,6 +166,14 @@ class SB3Policy:
         start = (np.ones(n, bool) if episode_start is None and not state
                  else np.zeros(n, bool) if episode_start is None
                  else np.broadcast_to(np.asarray(episode_start, bool).reshape(-1), (n,)).copy())
+        if self.residual is not None:  # the base reads the raw observation first, as in training
+            base, shaper = self.residual
+            b, state["base"] = base.predict(obs[:, :N_OBS], state=state.get("base"),
+                                            episode_start=start, deterministic=True)
+            if self.observe_estimate:
+                obs = np.hstack([obs, base.estimate_features(state["base"])])
+        if self.norm is not None:
+            obs = self.norm.normalize_obs(obs)
         if self.frame_stack > 1:
             d = obs.shape[1]
             stack = state.get("stack")
@@ -173,9 +192,6 @@ class SB3Policy:
             a, _ = self.model.predict(obs, deterministic=deterministic)
         a = np.asarray(a, np.float64).reshape(-1)
         if self.residual is not None:
-            base, shaper = self.residual
-            b, state["base"] = base.predict(raw, state=state.get("base"), episode_start=start,
-                                            deterministic=True)
             a, state["filter"] = shaper(b, a, state.get("filter"), start)
             a = a[:, 0]
         return to_actions(a, single), state
@@ -335,4 +351,5 @@ def load_sb3(path: str | Path, residual_factory=None) -> SB3Policy:
             raise PolicyError(f"{path} is a residual policy on {spec.get('base')!r}: load it "
                               "with load_policy, which builds the base policy")
         residual = residual_factory(spec)
-    return SB3Policy(model, norm, frame_stack=k, residual=residual)
+    return SB3Policy(model, norm, frame_stack=k, residual=residual,
+                     observe_estimate=wrappers.get("residual", {}).get("observe_estimate", False))

@@ -18,12 +18,18 @@ separate top-level block ``aerostat_gym``:
   observation (``lqg``, ``modal_lqg`` or ``tension``; the privileged ``lqr`` and ``modal``
   are refused),
   designed for the training configuration and the training sensor noise, keeping its own
-  state and reset at every episode start (:mod:`aerostat_gym.agents.residual`).
+  state and reset at every episode start (:mod:`aerostat_gym.agents.residual`). With
+  ``observe_estimate: true`` (Kalman-filter bases) the policy also reads the base's estimate:
+  the measured channels the filter reconstructs and the base's command.
 - ``score_reward: true`` (or ``{floor: F}``): train on the evaluator's score, each episode's
   rewards divided by the braked winch's return on the same episode
   (:mod:`aerostat_gym.agents.score_reward`), so that a calm 1 m swing weighs as much as a
   turbulent high-wind episode, as in the aggregate score. Training only: the saved policy is
   run as any other.
+- ``asymmetric_critic: true`` (PPO): the critic reads the privileged full state (the training
+  environments give ``observation="full"``), the actor only the standard channels and the
+  residual base's estimate (:mod:`aerostat_gym.agents.asymmetric`); the value function is
+  discarded at deployment, so the policy still acts on the sensors alone.
 
 Algorithms: ``ppo``, ``sac``, ``td3`` (Stable-Baselines3) and ``rppo`` (sb3-contrib's
 RecurrentPPO, an LSTM policy, ``policy: MlpLstmPolicy``).
@@ -60,6 +66,8 @@ from ..envs.sb3 import sb3_vec_env
 from ..params import Params, dumps_toml, load_params
 from ..registration import TASKS
 from ..resources import shipped_path
+from .asymmetric import actor_channels
+from .asymmetric import policy_class as asymmetric_policy_class
 from .evaluate import check_suite, suite_score
 from .policies import load_policy
 from .report import plot_training_curve
@@ -82,7 +90,7 @@ RESERVED = {"n_timesteps", "n_envs", "policy", "normalize", "noise_type", "noise
             "policy_kwargs"}
 PROJECT_BLOCK = "aerostat_gym"
 PROJECT_KEYS = {"eval_freq", "eval_suite", "env_kwargs", "frame_stack", "residual",
-                "score_reward"}
+                "score_reward", "asymmetric_critic"}
 
 
 class TrainingError(ValueError):
@@ -194,7 +202,8 @@ def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict 
     if wrappers.get("residual"):
         res = wrappers["residual"]
         venv = residual_vec_env(venv, base,
-                                residual_shaper(res, float(env_kwargs.get("control_step", 0.2))))
+                                residual_shaper(res, float(env_kwargs.get("control_step", 0.2))),
+                                observe_estimate=res.get("observe_estimate", False))
     if normalize is not None:
         if stats is not None and Path(stats).is_file():
             venv = VecNormalize.load(str(stats), venv)
@@ -211,7 +220,8 @@ def run_policy(model, wrappers: dict, base=None, dt: float = 0.2) -> SB3Policy:
     res = wrappers.get("residual")
     return SB3Policy(model, find_vecnormalize(model.get_env()),
                      frame_stack=wrappers.get("frame_stack", 1),
-                     residual=(base, residual_shaper(res, dt)) if res else None)
+                     residual=(base, residual_shaper(res, dt)) if res else None,
+                     observe_estimate=bool(res and res.get("observe_estimate", False)))
 
 
 def _count(name: str, value) -> int:
@@ -259,12 +269,17 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
         score = check_score_reward(project.get("score_reward"))
     except PolicyError as exc:
         raise TrainingError(str(exc)) from None
+    asymmetric = check_asymmetric(project.get("asymmetric_critic", False), algo,
+                                  hp.get("policy", "MlpPolicy"), wrappers)
+    if asymmetric:  # the critic's privileged channels
+        env_kwargs["observation"] = "full"
     venv = make_training_env(n_envs, seed, env_kwargs, normalize_kwargs(hp), wrappers, base,
                              stats=vecnormalize_path(Path(resume)) if resume else None,
                              score_reward=score)
     _write_run_files(run, algo, task_id, {task_id: hp, PROJECT_BLOCK: project}, venv, seed,
                      n_envs, timesteps)
-    model = _model(algo, hp, venv, seed, run, resume)
+    model = _model(algo, hp, venv, seed, run, resume,
+                   actor_only=_actor_channels(venv, wrappers, base) if asymmetric else None)
     freq = int(eval_freq or project.get("eval_freq", 50_000))
     suite_cb = suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1),
                                    run, env_kwargs.get("params"), on_eval, wrappers, base)
@@ -380,12 +395,34 @@ def _tensorboard_dir(run: Path) -> str | None:
     return str(run / "tb")
 
 
-def _model(algo, hp, venv, seed, run, resume):
+def check_asymmetric(flag, algo: str, policy: str, wrappers: dict) -> bool:
+    """The validated ``asymmetric_critic`` option: a boolean, for PPO's MlpPolicy without a
+    frame stack."""
+    if not isinstance(flag, bool):
+        raise TrainingError(f"asymmetric_critic must be true or false, got {flag!r}")
+    if flag and (algo != "ppo" or policy != "MlpPolicy"):
+        raise TrainingError(f"asymmetric_critic is an option of PPO's MlpPolicy (actor and "
+                            f"critic networks apart); got algo {algo!r}, policy {policy!r}")
+    if flag and wrappers.get("frame_stack", 1) > 1:
+        raise TrainingError("asymmetric_critic cannot be combined with frame_stack")
+    return flag
+
+
+def _actor_channels(venv, wrappers: dict, base) -> list[int]:
+    """The channels an asymmetric actor reads in the training observation."""
+    observe = (wrappers.get("residual") or {}).get("observe_estimate", False)
+    return actor_channels(venv.observation_space.shape[0], base.n_features if observe else 0)
+
+
+def _model(algo, hp, venv, seed, run, resume, actor_only=None):
+    """The SB3 model (``actor_only``: the channels of an asymmetric actor-critic's actor)."""
     Algo = _algorithm(algo)
     tb = _tensorboard_dir(run)
     kwargs = {k: v for k, v in hp.items() if k not in RESERVED}
-    if hp.get("policy_kwargs"):
-        pk = dict(hp["policy_kwargs"])
+    if hp.get("policy_kwargs") or actor_only:
+        pk = dict(hp.get("policy_kwargs") or {})
+        if actor_only:
+            pk["actor_channels"] = actor_only
         kwargs["policy_kwargs"] = pk
     if algo == "td3" and hp.get("noise_type"):
         from stable_baselines3.common.noise import NormalActionNoise
@@ -395,6 +432,8 @@ def _model(algo, hp, venv, seed, run, resume):
     if resume:  # the VecNormalize statistics saved beside it are already in venv
         return Algo.load(Path(resume), env=venv, seed=seed, tensorboard_log=tb)
     policy = hp.get("policy", "MlpLstmPolicy" if algo == "rppo" else "MlpPolicy")
+    if actor_only:
+        policy = asymmetric_policy_class()
     return Algo(policy, venv, seed=seed, verbose=0, tensorboard_log=tb, **kwargs)
 
 
