@@ -126,6 +126,20 @@ def design_result(design: Design, params: Params, suite: str = "report") -> dict
     return suite_result(design.policy(params), design.label, suite, params)
 
 
+def _at_speed(rows: list[dict], u: float) -> list[dict]:
+    """The episodes of ``rows`` at wind speed ``u``."""
+    return [r for r in rows if r["wind_speed"] == u]
+
+
+def _mean_row(scenario: str, u: float, label: str, episodes: list[dict], names) -> dict:
+    """A table row: the cell's keys and the mean over ``episodes`` of each metric in ``names``
+    (NaN entries, e.g. failed fits, left out)."""
+    row = {"scenario": scenario, "wind_speed": float(u), "design": label}
+    for name in names:
+        row[name] = float(np.nanmean(_metric(episodes, name)))
+    return row
+
+
 def gust_rows(label: str, rows: list[dict], passive: list[dict], scenario: str,
               speeds) -> list[dict]:
     """One row per wind speed of a gusty scenario: the design's means, the ratios of its mean
@@ -133,12 +147,10 @@ def gust_rows(label: str, rows: list[dict], passive: list[dict], scenario: str,
     of each of :data:`GUST_TARGETS`."""
     out = []
     for u in speeds:
-        mine = [r for r in rows if r["wind_speed"] == u]
-        ref = [r for r in passive if r["wind_speed"] == u]
-        row = {"scenario": scenario, "wind_speed": float(u), "design": label}
-        for name in ("rms_x_m", "rms_pitch_rad", "peak_tension_N", "length_wander_m",
-                     "peak_reel_speed_m_s", "terminated"):
-            row[name] = float(np.nanmean(_metric(mine, name)))
+        mine, ref = _at_speed(rows, u), _at_speed(passive, u)
+        row = _mean_row(scenario, u, label, mine,
+                        ("rms_x_m", "rms_pitch_rad", "peak_tension_N", "length_wander_m",
+                         "peak_reel_speed_m_s", "terminated"))
         row["rms_x_ratio"] = row["rms_x_m"] / float(np.nanmean(_metric(ref, "rms_x_m")))
         row["rms_pitch_ratio"] = (row["rms_pitch_rad"]
                                   / float(np.nanmean(_metric(ref, "rms_pitch_rad"))))
@@ -158,11 +170,8 @@ def recover_rows(label: str, rows: list[dict], passive: list[dict], speeds) -> l
     length wander and peak reel speed, and its pitch damping minus passive's."""
     out = []
     for u in speeds:
-        mine = [r for r in rows if r["wind_speed"] == u]
-        ref = [r for r in passive if r["wind_speed"] == u]
-        row = {"scenario": "recover", "wind_speed": float(u), "design": label}
-        for name in (*RECOVER_METRICS, "peak_reel_speed_m_s"):
-            row[name] = float(np.nanmean(_metric(mine, name)))
+        mine, ref = _at_speed(rows, u), _at_speed(passive, u)
+        row = _mean_row("recover", u, label, mine, (*RECOVER_METRICS, "peak_reel_speed_m_s"))
         row["pitch_zeta_change"] = row["pitch_zeta"] - float(
             np.nanmean(_metric(ref, "pitch_zeta")))
         out.append(row)
