@@ -20,7 +20,7 @@ from aerostat_gym.agents.evaluate import (
     suite_seeds,
 )
 from aerostat_gym.agents.metrics import response_metrics
-from aerostat_gym.agents.poi_split import poi_split, split_markdown
+from aerostat_gym.agents.poi_split import lost_by_all, lost_markdown, poi_split, split_markdown
 from aerostat_gym.agents.policies import PassivePolicy
 from aerostat_gym.agents.protocol import cell_markdown, protocol, protocol_markdown
 from aerostat_gym.agents.returns import RETURN_SEEDS
@@ -323,6 +323,16 @@ def test_poi_split_on_constructed_results():
     assert split["turbulent"] == 10 / 16 and split["turbulent_paired_win"] == 1.0
     assert split["p"] == pytest.approx((1.0 + 0.0 + 10 / 16) / 3)
     assert split["bound"] == pytest.approx((2.0 + 10 / 16) / 3)
-    assert "| x | y | 0.54 | 0.50 (2) | 0.62 (1) | 1.00 | 0.88 |" in split_markdown([split])
+    assert split["calm_lost"] == 1  # recover_small: each of x's episodes below each of y's
+    assert "| x | y | 0.54 | 0.50 (2) | 0.62 (1) | 1.00 | 0.88 | 1 |" in split_markdown([split])
     with pytest.raises(ValueError, match="'z'"):
         poi_split(results, "z", "y")
+    # lost by all: x and passive both lose recover_small outright to y (passive also loses
+    # recover, x does not), so one of the three cells is lost by both: cap 2 / 3
+    lost = lost_by_all(results, ["x", "passive"], "y")
+    assert lost["cells"] == [("recover_small", 10.0)] and lost["cap"] == pytest.approx(2 / 3)
+    assert lost_by_all(results, ["passive"], "y")["cells"] == [("recover", 10.0),
+                                                               ("recover_small", 10.0)]
+    assert "| y | 1: recover_small 10 | 0.67 |" in lost_markdown([lost])
+    with pytest.raises(ValueError, match="'z'"):
+        lost_by_all(results, ["z"], "y")

@@ -107,3 +107,8 @@ def test_poi_split_script_writes_its_table(tmp_path, capsys):
     assert (tmp_path / "s.md").read_text() in capsys.readouterr().out
     with pytest.raises(SystemExit, match="'zz'"):
         split.main([str(report), "--x", "zz", "--y", "passive"])
+    # --lost: passive loses the calm cell outright to a, so a P over a is capped at 1/2
+    split.main([str(report), "--x", "passive", "--y", "a", "--lost", "--json",
+                str(tmp_path / "l.json")])
+    lost = json.loads((tmp_path / "l.json").read_text())[0]
+    assert lost["cells"] == [["recover", 10.0]] and lost["cap"] == 0.5
