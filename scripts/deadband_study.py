@@ -10,8 +10,11 @@ Usage::
     PYTHONPATH=. python scripts/deadband_study.py [--policy shipped] [--policy run/ppo_final.zip]
         [--deadband 0.05] [--lowpass 1.0] [--shaped modal_lqg]
         [--reference agents/baseline_report/report.json] [--json out.json]
+        [--suite validation] [--results shaped.json]
 
-About 2.5 minutes per policy on one core.
+About 2.5 minutes per policy on one core (report suite). ``--results`` writes the shaped
+policies' episodes as a list of evaluation results, the format of ``report.json``, for
+``scripts/poi_split.py`` and ``scripts/select_policy.py`` to read beside other reports.
 """
 
 from __future__ import annotations
@@ -58,6 +61,10 @@ def main(argv=None) -> list[dict]:
                     help="read the unshaped policies' episodes from the report.json of an "
                          "`aerostat-gym evaluate --suite report` run instead of running them")
     ap.add_argument("--json", default=None, help="write the aggregate to this JSON file")
+    ap.add_argument("--suite", default="report", choices=("report", "validation"),
+                    help="the frozen suite to run (default: report)")
+    ap.add_argument("--results", default=None,
+                    help="write the shaped policies' episodes here (report.json format)")
     args = ap.parse_args(argv)
     params = load_params()
     names = ["passive", "modal", "modal_lqg"] + (args.policy or ["shipped"])
@@ -77,20 +84,25 @@ def main(argv=None) -> list[dict]:
             runs.append((label, ShapedPolicy(pol, args.deadband, args.lowpass)))
         for label, p in runs:
             t0 = time.perf_counter()
-            results.append(suite_result(p, label, "report", params))
+            results.append(suite_result(p, label, args.suite, params))
             print(f"  {label}: {time.perf_counter() - t0:.0f} s", flush=True)
     agg = protocol.aggregate(results)["aggregate"]
+    keys = KEY_CELLS if args.suite == "report" else ()  # the key cells' speeds are the report's
     print("| policy | IQM [95% CI] | P(> passive) | P(> modal_lqg) | P(> modal) | "
-          + " | ".join(f"{m} {sc} {u:g}" for sc, u, m in KEY_CELLS) + " |")
-    print("|---" * (5 + len(KEY_CELLS)) + "|")
+          + "".join(f"{m} {sc} {u:g} | " for sc, u, m in keys).rstrip())
+    print("|---" * (5 + len(keys)) + "|")
     for r in results:
         row, p = agg[r["label"]], agg[r["label"]]["p_improvement"]
         ps = [f"{p[o]['p']:.2f}" if o in p else "" for o in ("passive", "modal_lqg", "modal")]
+        cells = key_cells(r) if keys else []
         print(f"| {r['label']} | {row['iqm']:.3f} [{row['iqm_ci'][0]:.3f}, {row['iqm_ci'][1]:.3f}]"
-              f" | {' | '.join(ps)} | " + " | ".join(f"{v:.3f}" for v in key_cells(r)) + " |")
+              f" | {' | '.join(ps)} | " + "".join(f"{v:.3f} | " for v in cells).rstrip())
     if args.json:
         with open(args.json, "w") as f:
             json.dump(protocol.json_safe(agg), f, indent=1)
+    if args.results:
+        with open(args.results, "w") as f:
+            json.dump(protocol.json_safe([r for r in results if r["label"] not in names]), f)
     return results
 
 
