@@ -6,7 +6,7 @@ __version__ = "0.7.0"
 #: Oldest version whose registered tasks (dynamics, wind, reward, winch logic) and residual
 #: command path this version reproduces: a policy trained by it or later runs here as it was
 #: trained (0.5 added a baseline and stricter loading, 0.6 training options and an optional
-#: per-episode turbulence draw; every 0.4 report row reproduced).
+#: per-episode turbulence draw, 0.7 training options; every 0.4 report row reproduced).
 TASKS_COMPATIBLE_SINCE = "0.4.0"
 
 register()

@@ -88,15 +88,15 @@ def main(argv=None) -> list[dict]:
             print(f"  {label}: {time.perf_counter() - t0:.0f} s", flush=True)
     agg = protocol.aggregate(results)["aggregate"]
     keys = KEY_CELLS if args.suite == "report" else ()  # the key cells' speeds are the report's
-    print("| policy | IQM [95% CI] | P(> passive) | P(> modal_lqg) | P(> modal) | "
-          + "".join(f"{m} {sc} {u:g} | " for sc, u, m in keys).rstrip())
+    print(("| policy | IQM [95% CI] | P(> passive) | P(> modal_lqg) | P(> modal) | "
+           + "".join(f"{m} {sc} {u:g} | " for sc, u, m in keys)).rstrip())
     print("|---" * (5 + len(keys)) + "|")
     for r in results:
         row, p = agg[r["label"]], agg[r["label"]]["p_improvement"]
         ps = [f"{p[o]['p']:.2f}" if o in p else "" for o in ("passive", "modal_lqg", "modal")]
         cells = key_cells(r) if keys else []
-        print(f"| {r['label']} | {row['iqm']:.3f} [{row['iqm_ci'][0]:.3f}, {row['iqm_ci'][1]:.3f}]"
-              f" | {' | '.join(ps)} | " + "".join(f"{v:.3f} | " for v in cells).rstrip())
+        print((f"| {r['label']} | {row['iqm']:.3f} [{row['iqm_ci'][0]:.3f}, {row['iqm_ci'][1]:.3f}]"
+              f" | {' | '.join(ps)} | " + "".join(f"{v:.3f} | " for v in cells)).rstrip())
     if args.json:
         with open(args.json, "w") as f:
             json.dump(protocol.json_safe(agg), f, indent=1)
