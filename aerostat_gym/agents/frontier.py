@@ -286,7 +286,9 @@ BASELINE_MARKERS = {"passive": ("s", "black", "passive (braked winch)"),
                     "lqg": ("v", "tab:purple", "LQG (sensor noise)"),
                     "modal_lqg": ("h", "tab:brown", "modal on a Kalman filter (sensor noise)"),
                     "modal_lqg_shaped": ("p", "tab:gray",
-                                         "the same, 1 s low-pass + deadband (sensor noise)")}
+                                         "the same, 1 s low-pass + deadband (sensor noise)"),
+                    "modal_lqg_lowpass": ("P", "tab:blue",
+                                          "the same, 1 s low-pass only (sensor noise)")}
 #: Colours the learned policies take in turn.
 LEARNED_COLOURS = ("gold", "tab:orange", "tab:pink", "tab:cyan", "tab:olive")
 #: Legend names of learned policies known by name (others: their name).
