@@ -14,7 +14,7 @@ deterministic)`` signature, so one evaluator runs baselines and trained models a
   :data:`SHAPED_DEADBAND`), the bar the shipped learned residual on it has to clear.
 - ``modal_lqg_lowpass``: ``modal_lqg`` through the same low-pass without the deadband (0.7): on
   the report and validation suites better than ``modal_lqg_shaped`` (P 0.60 and 0.57), the
-  strongest policy on the noisy sensors measured so far (docs/learned.md).
+  best validation IQM of the policies on noisy sensors measured so far (docs/learned.md).
 - :class:`aerostat_gym.agents.sb3io.SB3Policy`: a trained model with its VecNormalize
   statistics.
 
