@@ -29,9 +29,7 @@ def poi_split(results: list[dict], x: str, y: str) -> dict:
     """P(X > Y) of the aggregate over all cells, over the calm and the turbulent cells, the
     paired win rate of X over Y in the turbulent cells, and the bound with every calm cell won
     (``results`` as for :func:`aerostat_gym.agents.protocol.aggregate`, both labels among them)."""
-    _check_labels(results, (x, y))
-    _, mats = scores(results)
-    gusty = np.array([s in GUSTY_SCENARIOS for s, _ in aggregate_cells(results)])
+    _, gusty, mats = _scored_cells(results, (x, y))
     p = poi_per_task(mats[x], mats[y])
     diff = mats[x] - mats[y]  # same seed, same episode start and wind field
     paired = (diff > 0).mean(axis=0) + 0.5 * (diff == 0).mean(axis=0)
@@ -48,10 +46,7 @@ def lost_by_all(results: list[dict], xs, y: str) -> dict:
     """The calm cells that every policy of ``xs`` loses outright to ``y`` (P(X > Y) = 0 in the
     cell), as (scenario, wind speed) pairs, and ``cap``: P over Y with those cells lost and every
     other cell won outright."""
-    _check_labels(results, [*xs, y])
-    _, mats = scores(results)
-    cells = aggregate_cells(results)
-    gusty = np.array([s in GUSTY_SCENARIOS for s, _ in cells])
+    cells, gusty, mats = _scored_cells(results, [*xs, y])
     lost = ~gusty
     for x in xs:
         lost &= poi_per_task(mats[x], mats[y]) == 0.0
@@ -59,11 +54,16 @@ def lost_by_all(results: list[dict], xs, y: str) -> dict:
             "cap": float(1.0 - lost.mean()), "n_cells": len(cells)}
 
 
-def _check_labels(results: list[dict], wanted) -> None:
+def _scored_cells(results: list[dict], wanted):
+    """The aggregate's cells, which of them are turbulent, and every policy's score matrix
+    (seeds x cells), once the ``wanted`` labels are found among the results."""
     labels = [r["label"] for r in results]
     missing = [lab for lab in wanted if lab not in labels]
     if missing:
         raise ValueError(f"poi_split: {missing} not among the results' labels {labels}")
+    cells = aggregate_cells(results)
+    _, mats = scores(results)
+    return cells, np.array([s in GUSTY_SCENARIOS for s, _ in cells]), mats
 
 
 def split_markdown(rows: list[dict]) -> str:
