@@ -294,10 +294,19 @@ def suite_episodes(policy, suite: str, control_step: float = 0.2, params=None):
     the environment of ``params`` (a Params; None: the baseline) with the suite's sensor
     noise: the one loop behind :func:`evaluate_policy`, :func:`suite_result` and
     :func:`suite_score`."""
-    kwargs = {"obs_noise": SUITE_OBS_NOISE.get(suite, 0.0)}
+    yield from cells_episodes(policy, check_suite(suite), SUITE_OBS_NOISE.get(suite, 0.0),
+                              control_step, params)
+
+
+def cells_episodes(policy, cells: dict, obs_noise: float, control_step: float = 0.2,
+                   params=None):
+    """(scenario, :class:`Episodes`) for every scenario of ``cells`` ({scenario: (speeds,
+    seeds)}, the form of :data:`SUITES`' entries), each run in one batch with sensor noise
+    ``obs_noise`` in the environment of ``params`` (None: the baseline)."""
+    kwargs = {"obs_noise": obs_noise}
     if params is not None:
         kwargs["params"] = params
-    for scenario, (speeds, seeds) in check_suite(suite).items():
+    for scenario, (speeds, seeds) in cells.items():
         yield scenario, run_scenario(policy, scenario, speeds, seeds, control_step,
                                      env_kwargs=kwargs)
 
@@ -336,10 +345,19 @@ def suite_result(policy, label: str, suite: str = "report", params=None) -> dict
     evaluation result without the histories (what :func:`aerostat_gym.agents.protocol.aggregate`
     reads): for policies that have no name, such as a design of the authority sweep or a
     baseline wrapped in a deadband."""
+    return cells_result(policy, label, check_suite(suite), SUITE_OBS_NOISE.get(suite, 0.0),
+                        params, suite=suite)
+
+
+def cells_result(policy, label: str, cells: dict, obs_noise: float, params=None,
+                 suite: str = "custom") -> dict:
+    """:func:`suite_result` on any cells ({scenario: (speeds, seeds)}) at sensor noise
+    ``obs_noise``: the same result format, for studies that run the suites' scenarios at other
+    wind speeds or seeds."""
     scenarios = {sc: {"episodes": [episode_metrics(ep, i) for i in range(len(ep.speeds))]}
-                 for sc, ep in suite_episodes(policy, suite, params=params)}
-    return {"policy": label, "label": label, "suite": suite,
-            "obs_noise": SUITE_OBS_NOISE.get(suite, 0.0), "scenarios": scenarios}
+                 for sc, ep in cells_episodes(policy, cells, obs_noise, params=params)}
+    return {"policy": label, "label": label, "suite": suite, "obs_noise": float(obs_noise),
+            "scenarios": scenarios}
 
 
 def suite_score(policy, suite: str = "tiny", control_step: float = 0.2, params=None) -> float:
