@@ -18,9 +18,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from ..params import Params
+from .authority import gust_rows, recover_rows
 from .evaluate import (
     REPORT_RECOVER_SPEEDS,
     SENSOR_NOISE,
@@ -66,40 +65,38 @@ def lowpass_designs(taus, base: str = "modal_lqg", deadband: float = 0.0) -> lis
                          float(t), float(deadband)) for t in taus]
 
 
-def _recover_row(result: dict, baselines: dict, u: float) -> dict:
-    """The recover cell at ``u``: the design's means against passive's and modal's, and the
-    paired interval of its pitch damping minus passive's."""
-    def mean(res, metric):
-        return float(np.nanmean(cell_values(res, "recover", u, metric)[1]))
-
-    pitch = cell_values(result, "recover", u, "pitch_zeta")[1]
-    iv = paired_interval(pitch, cell_values(baselines["passive"], "recover", u, "pitch_zeta")[1])
-    return {"wind_speed": u, "pendulum_zeta": mean(result, "pendulum_zeta"),
-            "modal_pendulum_zeta": mean(baselines["modal"], "pendulum_zeta"),
-            "pitch_zeta": mean(result, "pitch_zeta"),
-            "pitch_change": mean(result, "pitch_zeta") - mean(baselines["passive"], "pitch_zeta"),
-            "pitch_change_ci": None if iv is None else [iv.low, iv.high],
-            "length_wander_m": mean(result, "length_wander_m"),
-            "modal_length_wander_m": mean(baselines["modal"], "length_wander_m")}
-
-
-def _gust_ratio(result: dict, passive: dict, scenario: str, u: float) -> float:
-    mine = cell_values(result, scenario, u, "rms_x_m")[1]
-    ref = cell_values(passive, scenario, u, "rms_x_m")[1]
-    return float(np.nanmean(mine) / np.nanmean(ref))
+def _episodes(result: dict, scenario: str) -> list[dict]:
+    return result["scenarios"][scenario]["episodes"]
 
 
 def design_row(label: str, result: dict, baselines: dict, cells: dict) -> dict:
-    """A design's summary: targets met of the selection's checks (and which were missed),
-    its recover rows and its RMS x ratio to passive's in each turbulent cell."""
+    """A design's summary: targets met of the selection's checks (and which were missed);
+    its recover rows (:func:`aerostat_gym.agents.authority.recover_rows`) with modal's
+    pendulum damping and wander beside them and the paired interval of its pitch damping minus
+    passive's; its RMS x ratio to passive's in each turbulent cell (from
+    :func:`aerostat_gym.agents.authority.gust_rows`)."""
     checks = target_checks(result, baselines)
+    passive, speeds = baselines["passive"], cells["recover"][0]
+    recover = recover_rows(label, _episodes(result, "recover"), _episodes(passive, "recover"),
+                           speeds)
+    modal = recover_rows("modal", _episodes(baselines["modal"], "recover"),
+                         _episodes(passive, "recover"), speeds)
+    for row, ref in zip(recover, modal, strict=True):
+        u = row["wind_speed"]
+        iv = paired_interval(cell_values(result, "recover", u, "pitch_zeta")[1],
+                             cell_values(passive, "recover", u, "pitch_zeta")[1])
+        row["pitch_zeta_change_ci"] = None if iv is None else [iv.low, iv.high]
+        row["modal_pendulum_zeta"] = ref["pendulum_zeta"]
+        row["modal_length_wander_m"] = ref["length_wander_m"]
+    ratios = {f"{g['scenario']} {g['wind_speed']:g}": g["rms_x_ratio"]
+              for sc in cells if sc != "recover"
+              for g in gust_rows(label, _episodes(result, sc), _episodes(passive, sc), sc,
+                                 cells[sc][0])}
     return {"label": label, "targets_met": sum(c["met"] for c in checks),
             "targets": len(checks),
             "missed": [f"{c['target']} ({c['scenario']} {c['wind_speed']:g} m/s)"
                        for c in checks if not c["met"]],
-            "recover": [_recover_row(result, baselines, u) for u in cells["recover"][0]],
-            "rms_x_ratio": {f"{sc} {u:g}": _gust_ratio(result, baselines["passive"], sc, u)
-                            for sc in cells if sc != "recover" for u in cells[sc][0]}}
+            "recover": recover, "rms_x_ratio": ratios}
 
 
 def command_path_study(params: Params, designs, cells: dict | None = None,
@@ -140,8 +137,8 @@ def study_markdown(study: dict) -> str:
             "length wander [m] (modal) |", "|---|---|---|---|---|"]
     for r in rows:
         out += [f"| {r['label']} | {c['wind_speed']:g} | {c['pendulum_zeta']:.3f} "
-                f"({c['modal_pendulum_zeta']:.3f}) | {c['pitch_change']:+.4f}"
-                f"{_ci(c['pitch_change_ci'])} | {c['length_wander_m']:.2f} "
+                f"({c['modal_pendulum_zeta']:.3f}) | {c['pitch_zeta_change']:+.4f}"
+                f"{_ci(c['pitch_zeta_change_ci'])} | {c['length_wander_m']:.2f} "
                 f"({c['modal_length_wander_m']:.2f}) |" for c in r["recover"]]
     keys = list(rows[0]["rms_x_ratio"]) if rows else []
     out += ["", "| design | " + " | ".join(f"RMS x / passive, {k} m/s" for k in keys) + " |",
