@@ -131,6 +131,11 @@ def test_invalid_arguments_name_the_problem():
         TetheredAerostatEnv(perturbation="earthquake")
     with pytest.raises(ValueError, match="render_mode"):
         TetheredAerostatEnv(render_mode="ascii")
+    with pytest.raises(TaskError, match=r"'control_dt' \(did you mean 'control_step'\?\)"):
+        TetheredAerostatEnv(control_dt=0.1)
+    with pytest.raises(TaskError, match="unknown environment argument.*'foo'"):
+        gym.make_vec("TetheredAerostat-v0", num_envs=2, vectorization_mode="vector_entry_point",
+                     foo=1)
     for noise in (-0.01, float("nan"), True, "0.01"):  # one shared check (envs.spaces)
         with pytest.raises(TaskError, match="obs_noise"):
             TetheredAerostatEnv(obs_noise=noise)

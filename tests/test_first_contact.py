@@ -142,6 +142,9 @@ def test_commands_work_from_any_directory(tmp_path):
 
 @pytest.mark.parametrize("args, needle", [
     (["demo", "--policy", "missing.zip"], "policy file not found: missing.zip"),
+    (["evaluate", "--policy", "passive", "--policy", "missing.zip"],
+     "--policy missing.zip: policy file not found: missing.zip"),
+    (["evaluate", "--policy", "pasive"], "unknown policy 'pasive' (did you mean 'passive'?)"),
     (["train", "--timesteps", "0"], "argument --timesteps: expected an integer >= 1, got '0'"),
     (["train", "--hyperparams", "nope.yml"], "hyperparameter file not found: nope.yml"),
 ])

@@ -23,6 +23,7 @@ deterministic)`` signature, so one evaluator runs baselines and trained models a
 
 from __future__ import annotations
 
+import difflib
 from pathlib import Path
 
 import numpy as np
@@ -162,5 +163,7 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
         return load_sb3(shipped_path(SHIPPED[name]), residual_factory)
     if name.endswith(".zip") or Path(name).exists():
         return load_sb3(name, residual_factory)
-    raise PolicyError(f"unknown policy {name!r}: use one of {BASELINES + tuple(SHIPPED)} or a "
-                      "path to a .zip")
+    close = difflib.get_close_matches(name, BASELINES + tuple(SHIPPED), 1)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    raise PolicyError(f"unknown policy {name!r}{hint}: use one of "
+                      f"{BASELINES + tuple(SHIPPED)} or a path to a .zip")

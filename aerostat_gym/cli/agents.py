@@ -68,7 +68,20 @@ def add_evaluate_parser(sub) -> None:
     p.set_defaults(func=_evaluate_command)
 
 
+def _check_policies(names) -> None:
+    """Refuse an unknown name or a missing or corrupt policy file before any work (the
+    baselines are designed per run, so only the learned policies are loaded here)."""
+    for name in names:
+        if name in BASELINES:
+            continue
+        try:
+            load_policy(name)
+        except (ValueError, OSError) as exc:
+            raise ValueError(f"--policy {name}: {exc}") from None
+
+
 def _evaluate_command(args) -> int:
+    _check_policies(args.policy)
     results = run_evaluations(args.policy, args.suite, progress=not args.json,
                               params=params_from_args(args))
     md = write_report(results, args.out, f"Evaluation on suite `{args.suite}`",
@@ -100,10 +113,7 @@ def add_demo_parser(sub) -> None:
 
 def _demo_command(args) -> int:
     t0 = time.perf_counter()
-    try:  # a missing or corrupt policy is refused before any work
-        load_policy(args.policy)
-    except (ValueError, OSError) as exc:
-        raise ValueError(f"--policy {args.policy}: {exc}") from None
+    _check_policies([args.policy])
     params = params_from_args(args)
     policies = ["passive", "lqr"]
     if params == load_params() or args.policy != "shipped":

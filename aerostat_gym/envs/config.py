@@ -5,8 +5,9 @@ The episode start built from it is :mod:`aerostat_gym.envs.episodes`.
 
 from __future__ import annotations
 
+import difflib
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
@@ -84,6 +85,19 @@ class TaskConfig:
     wind_bank_size: int = 8
     wind_bank_seed: int = 0
     resolved: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @classmethod
+    def from_kwargs(cls, **kwargs) -> TaskConfig:
+        """The task from the environment's keyword arguments; a misspelt or unknown argument is
+        a :class:`TaskError` that names it, the nearest accepted name and every accepted one."""
+        accepted = [f.name for f in fields(cls) if f.name != "resolved"]
+        unknown = [k for k in kwargs if k not in accepted]
+        if unknown:
+            hints = [f"{k!r} (did you mean {close[0]!r}?)" if close else repr(k)
+                     for k in unknown for close in [difflib.get_close_matches(k, accepted, 1)]]
+            raise TaskError(f"unknown environment argument(s) {', '.join(hints)}; the task "
+                            f"accepts {', '.join(accepted)}")
+        return cls(**kwargs)
 
     def __post_init__(self):
         r = self.resolved

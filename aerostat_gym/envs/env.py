@@ -206,7 +206,7 @@ class TetheredAerostatEnv(gym.Env):
         if render_mode is not None and render_mode not in RENDER_MODES:
             raise ValueError(f"unknown render_mode {render_mode!r}; choose one of {RENDER_MODES}")
         self.render_mode = render_mode
-        self.task = TaskConfig(**kwargs)
+        self.task = TaskConfig.from_kwargs(**kwargs)
         self._batch = EnvBatch(self.task, 1)
         b = self._batch
         self.action_space = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)

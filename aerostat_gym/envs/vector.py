@@ -51,7 +51,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
                              "'rgb_array' (environment 0)")
         self.render_mode = render_mode
         self.metadata = {**self.metadata, "autoreset_mode": self.autoreset_mode}
-        self.task = TaskConfig(**kwargs)
+        self.task = TaskConfig.from_kwargs(**kwargs)
         self.max_episode_steps = int(max_episode_steps or DEFAULT_MAX_EPISODE_STEPS)
         self.num_envs = num_envs
         self.batch = EnvBatch(self.task, num_envs, threads)
