@@ -155,6 +155,11 @@ def test_protocol_verdicts_on_constructed_results():
     assert {d["verdict"] for d in same["cells"][0]["paired"]["twin"]["passive"].values()} \
         == {"indistinguishable"}
     assert "| twin | 0.280 | 0.300 | indistinguishable |" in protocol_markdown(same)
+    one_seed = protocol([_result(r["label"], "recover", r["scenarios"]["recover"]["episodes"][:1])
+                         for r in (passive, better)])
+    assert {d["verdict"] for d in one_seed["cells"][0]["paired"]["mine"]["passive"].values()} \
+        == {"n/a"}
+    assert "| n/a (fewer than 2 paired seeds: no interval) |" in protocol_markdown(one_seed)
 
 
 def test_protocol_refuses_unpaired_seeds():

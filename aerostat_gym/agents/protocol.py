@@ -299,7 +299,11 @@ def _verdict_text(paired: dict) -> str:
         if d["verdict"] in words:
             words[d["verdict"]].append(SHORT.get(m, m))
     parts = [f"{k}: {', '.join(v)}" for k, v in words.items() if v]
-    return "; ".join(parts) if parts else "indistinguishable"
+    if parts:
+        return "; ".join(parts)
+    if paired and all(d["verdict"] == "n/a" for d in paired.values()):
+        return "n/a (fewer than 2 paired seeds: no interval)"
+    return "indistinguishable"
 
 
 def cell_markdown(cell: dict, reference: str = "passive") -> str:
@@ -345,7 +349,7 @@ def protocol_markdown(proto: dict, reference: str = "passive") -> str:
         sc = SCENARIOS.get(cell["scenario"])
         desc = f" ({sc.description})" if sc is not None else ""
         parts += [f"### {cell['scenario']}, {cell['wind_speed']:g} m/s, "
-                  f"{cell['n_seeds']} seeds{desc}", "", cell_markdown(cell, ref), ""]
+                  f"{cell['n_seeds']} seed{'' if cell['n_seeds'] == 1 else 's'}{desc}", "", cell_markdown(cell, ref), ""]
     n_all, cells = len(proto["cells"]), proto["aggregate_cells"]
     over = ("all cells" if len(cells) == n_all else
             f"the {len(cells)} of {n_all} cells with the most seeds ({', '.join(cells)})")
