@@ -348,8 +348,9 @@ def protocol_markdown(proto: dict, reference: str = "passive") -> str:
     for cell in proto["cells"]:
         sc = SCENARIOS.get(cell["scenario"])
         desc = f" ({sc.description})" if sc is not None else ""
-        parts += [f"### {cell['scenario']}, {cell['wind_speed']:g} m/s, "
-                  f"{cell['n_seeds']} seed{'' if cell['n_seeds'] == 1 else 's'}{desc}", "", cell_markdown(cell, ref), ""]
+        seeds = f"{cell['n_seeds']} seed{'' if cell['n_seeds'] == 1 else 's'}"
+        parts += [f"### {cell['scenario']}, {cell['wind_speed']:g} m/s, {seeds}{desc}", "",
+                  cell_markdown(cell, ref), ""]
     n_all, cells = len(proto["cells"]), proto["aggregate_cells"]
     over = ("all cells" if len(cells) == n_all else
             f"the {len(cells)} of {n_all} cells with the most seeds ({', '.join(cells)})")
