@@ -164,3 +164,37 @@ def test_off_policy_configs_train(tmp_path, algo):
     assert model._n_updates == 120
     a, _ = model.predict(np.zeros(N_OBS, np.float32), deterministic=True)
     assert a.shape == (1,) and abs(float(a[0])) <= 1.0
+
+
+def test_suite_at_other_speeds_is_the_suite_cell_it_replaces():
+    """``speeds`` runs a suite's scenarios at other wind speeds on its own seeds: at a speed the
+    suite already has (10 m/s, inside the default schedule range), the modal controller's
+    episode is the suite's own to the last bit; at 18 m/s, beyond the training range, the
+    schedule is widened to cover it and the run records the speeds it used."""
+    from aerostat_gym.agents.evaluate import (
+        cells_wind_range,
+        describe_suite,
+        evaluate_policy,
+        suite_cells,
+    )
+    from aerostat_gym.agents.lqr import schedule_speeds
+
+    assert suite_cells("tiny", [18, 10]) == {"recover": ([10.0, 18.0], [0]),
+                                            "gusty": ([10.0, 18.0], [100, 101])}
+    assert "U = 10, 18 m/s; seeds 100, 101" in describe_suite("tiny", [10, 18])
+    for bad in ([], [5.0, 5.0], [float("nan")], [-1.0], ["x"]):
+        with pytest.raises(ValueError, match="speeds"):
+            suite_cells("tiny", bad)
+    own = evaluate_policy("modal", "damping")
+    at = evaluate_policy("modal", "damping", speeds=[10.0, 18.0])
+    assert own["speeds"] is None and at["speeds"] == [10.0, 18.0]
+    row = next(e for e in own["scenarios"]["recover"]["episodes"] if e["wind_speed"] == 10.0)
+    new = {e["wind_speed"]: e for e in at["scenarios"]["recover"]["episodes"]}
+    assert new[10.0]["pendulum_zeta"] == row["pendulum_zeta"]
+    assert new[10.0]["return"] == row["return"]
+    # the baselines' schedule covers 18 m/s (designed there, not clamped to 16 m/s)
+    assert cells_wind_range(suite_cells("damping", [10.0, 18.0])) == (3.0, 18.0)
+    assert schedule_speeds((3.0, 18.0))[-1] >= 18.0
+    passive = evaluate_policy("passive", "damping", speeds=[18.0])
+    assert new[18.0]["pendulum_zeta"] > 1.5 * passive["scenarios"]["recover"]["episodes"][0][
+        "pendulum_zeta"]  # 0.85 against 0.39 when written

@@ -146,16 +146,43 @@ def suite_seeds(name: str) -> set:
     return {s for _, seeds in check_suite(name).values() for s in seeds}
 
 
-def describe_suite(name: str) -> str:
-    """One line per scenario of a suite: wind speeds, seeds (as ranges) and description."""
+def suite_cells(name: str, speeds=None) -> dict:
+    """A suite's cells ({scenario: (speeds, seeds)}); with ``speeds`` (mean wind speeds [m/s],
+    finite, >= 0, no repeats) every scenario runs at those speeds instead, on the suite's own
+    seeds, sensor noise and durations: the suite's scenarios at the winds of your site."""
+    cells = check_suite(name)
+    if speeds is None:
+        return cells
+    try:
+        us = sorted(float(u) for u in speeds)
+    except (TypeError, ValueError):
+        raise ValueError(f"speeds must be numbers [m/s], got {speeds!r}") from None
+    if not us or not all(math.isfinite(u) and u >= 0.0 for u in us) \
+            or len(set(us)) != len(us):
+        raise ValueError(f"speeds must be finite wind speeds >= 0 m/s without repeats, got "
+                         f"{list(speeds)!r}")
+    return {sc: (us, seeds) for sc, (_, seeds) in cells.items()}
+
+
+def cells_wind_range(cells: dict) -> tuple[float, float]:
+    """The training range DEFAULT_WIND_RANGE widened to every speed of ``cells``: the range the
+    environments run in and the baselines are scheduled over."""
+    us = [u for speeds, _ in cells.values() for u in speeds]
+    lo, hi = DEFAULT_WIND_RANGE
+    return min(lo, min(us)), max(hi, max(us))
+
+
+def describe_suite(name: str, speeds=None) -> str:
+    """One line per scenario of a suite (at ``speeds`` if given, see :func:`suite_cells`): wind
+    speeds, seeds (as ranges) and description."""
     lines = []
-    for scenario, (speeds, seeds) in check_suite(name).items():
+    for scenario, (us, seeds) in suite_cells(name, speeds).items():
         s = sorted(seeds)
         span = (f"{s[0]}-{s[-1]}" if len(s) > 2 and s == list(range(s[0], s[-1] + 1))
                 else ", ".join(map(str, s)))
         lines.append(f"- `{scenario}` ({SCENARIOS[scenario].description}, "
                      f"{SCENARIOS[scenario].duration:g} s): U = "
-                     f"{', '.join(f'{u:g}' for u in speeds)} m/s; seeds {span}")
+                     f"{', '.join(f'{u:g}' for u in us)} m/s; seeds {span}")
     noise = SUITE_OBS_NOISE.get(name, 0.0)
     lines.append(f"- sensor noise obs_noise = {noise:g} (scaled units)")
     return "\n".join(lines)
@@ -199,8 +226,7 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     sc = SCENARIOS[scenario]
     pairs = [(u, s) for u in speeds for s in seeds]
     steps = int(round(sc.duration / control_step))
-    lo, hi = DEFAULT_WIND_RANGE
-    kwargs = {"wind_speed": (min(lo, min(speeds)), max(hi, max(speeds))),
+    kwargs = {"wind_speed": cells_wind_range({scenario: (speeds, seeds)}),
               **(env_kwargs or {}), **sc.env_kwargs}
     env = TetheredAerostatVectorEnv(num_envs=len(pairs), max_episode_steps=steps,
                                     observation="full", control_step=control_step, **kwargs)
@@ -289,13 +315,13 @@ def episode_metrics(ep: Episodes, i: int) -> dict:
     return m
 
 
-def suite_episodes(policy, suite: str, control_step: float = 0.2, params=None):
-    """(scenario, :class:`Episodes`) for every scenario of a suite, each run in one batch in
-    the environment of ``params`` (a Params; None: the baseline) with the suite's sensor
-    noise: the one loop behind :func:`evaluate_policy`, :func:`suite_result` and
-    :func:`suite_score`."""
-    yield from cells_episodes(policy, check_suite(suite), SUITE_OBS_NOISE.get(suite, 0.0),
-                              control_step, params)
+def suite_episodes(policy, suite: str, control_step: float = 0.2, params=None, speeds=None):
+    """(scenario, :class:`Episodes`) for every scenario of a suite (at ``speeds`` if given,
+    see :func:`suite_cells`), each run in one batch in the environment of ``params`` (a
+    Params; None: the baseline) with the suite's sensor noise: the one loop behind
+    :func:`evaluate_policy`, :func:`suite_result` and :func:`suite_score`."""
+    yield from cells_episodes(policy, suite_cells(suite, speeds),
+                              SUITE_OBS_NOISE.get(suite, 0.0), control_step, params)
 
 
 def cells_episodes(policy, cells: dict, obs_noise: float, control_step: float = 0.2,
@@ -312,24 +338,27 @@ def cells_episodes(policy, cells: dict, obs_noise: float, control_step: float = 
 
 
 def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float = 0.2,
-                    params=None) -> dict:
+                    params=None, speeds=None) -> dict:
     """Metrics of one policy on a suite: {scenario: [per-episode metrics]}, plus the score.
 
     ``params`` (a Params, a TOML path, a shipped configuration's name or None for the baseline)
     is the configuration of both the baselines' design and the environment the suite runs on;
     the resolved parameters are recorded in the result (``params_toml``). The suite's sensor
     noise (:data:`SUITE_OBS_NOISE`) is on in its environments and the LQG filter is designed
-    for it.
+    for it. With ``speeds`` every scenario runs at those wind speeds (:func:`suite_cells`), the
+    baselines scheduled over the range that covers them; the result records them (``speeds``).
     """
-    check_suite(suite)
+    cells = suite_cells(suite, speeds)
     noise = SUITE_OBS_NOISE.get(suite, 0.0)
     params = params if params is not None and not isinstance(params, str) else load_params(params)
-    policy = load_policy(policy_name, params=params, dt=control_step,
-                         wind_range=DEFAULT_WIND_RANGE, obs_noise=noise)
+    policy = load_policy(policy_name, params=params, dt=control_step, obs_noise=noise,
+                         wind_range=DEFAULT_WIND_RANGE if speeds is None
+                         else cells_wind_range(cells))
     out = {"policy": policy_name, "suite": suite, "scenarios": {}, "obs_noise": noise,
+           "speeds": None if speeds is None else cells[next(iter(cells))][0],
            "tether_length_m": params.tether.length, "params_toml": dumps_toml(params)}
     returns = []
-    for scenario, ep in suite_episodes(policy, suite, control_step, params):
+    for scenario, ep in suite_episodes(policy, suite, control_step, params, speeds):
         rows = [episode_metrics(ep, i) for i in range(len(ep.speeds))]
         if hasattr(policy, "predicted_modes"):
             for r in rows:

@@ -219,7 +219,7 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
     out.mkdir(parents=True, exist_ok=True)
     parts = [f"# {title}", "", f"Command: `{command}`", "", *(preamble or []),
              f"Suite `{results[0]['suite']}` (control step 0.2 s):", "",
-             describe_suite(results[0]["suite"]), "",
+             describe_suite(results[0]["suite"], results[0].get("speeds")), "",
              "Scores (mean episode return, default reward): " +
              ", ".join(f"{r['label']} {r['score']:.0f}" for r in results) + ". " +
              score_and_damping(results), ""]
@@ -243,7 +243,8 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
                   "IQM): `protocol.md`, data `protocol.json`.", ""]
         (out / "protocol.md").write_text(
             "\n".join([f"# Evaluation protocol: suite `{results[0]['suite']}`", "",
-                       f"Command: `{command}`", "", describe_suite(results[0]["suite"]), "",
+                       f"Command: `{command}`", "",
+                       describe_suite(results[0]["suite"], results[0].get("speeds")), "",
                        proto_mod.protocol_markdown(proto)]))
         (out / "protocol.json").write_text(proto_mod.dumps(proto))
     md = out / "report.md"
@@ -315,12 +316,13 @@ def cell_means(episodes: list[dict]) -> list[dict]:
 
 
 def run_evaluations(policies: list[str], suite: str, progress: bool = True,
-                    params=None) -> list[dict]:
-    """Evaluate every policy on ``suite`` in the environment of ``params`` (default baseline)."""
+                    params=None, speeds=None) -> list[dict]:
+    """Evaluate every policy on ``suite`` (at ``speeds`` if given) in the environment of
+    ``params`` (default baseline)."""
     labels = policy_labels(policies)
     results = []
     for name, label in zip(_progress(policies, progress, "evaluating"), labels, strict=True):
-        r = evaluate_policy(name, suite, params=params)
+        r = evaluate_policy(name, suite, params=params, speeds=speeds)
         r["label"] = label
         results.append(r)
     return results
