@@ -2,7 +2,7 @@
 
 from .registration import ENV_ID, register
 
-__version__ = "0.7.1"
+__version__ = "0.7.2"
 #: Oldest version whose registered tasks (dynamics, wind, reward, winch logic) and residual
 #: command path this version reproduces: a policy trained by it or later runs here as it was
 #: trained (0.5 added a baseline and stricter loading, 0.6 training options and an optional

@@ -89,7 +89,7 @@ def _check_policies(names) -> None:
 def _evaluate_command(args) -> int:
     _check_policies(args.policy)
     params = params_from_args(args)
-    if args.speeds is not None:  # refuse a speed the winch or tether cannot hold, up front
+    if args.speeds is not None:  # a speed whose trim the tether cannot hold: refused up front
         cells = suite_cells(args.suite, args.speeds)
         try:
             trim_table(TaskConfig.from_kwargs(wind_speed=cells_wind_range(cells),
