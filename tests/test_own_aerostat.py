@@ -425,5 +425,20 @@ def test_baselines_designed_for_the_configuration():
     assert periods and abs(periods[0] / 36.6 - 1.0) < 0.15, periods
 
 
+def test_shipped_policy_carries_to_the_32m_class_as_the_readme_says():
+    """The README's "Your own aerostat" table: the shipped policy, trained on the baseline only,
+    damps the 10 m swing of the 32 m class at 10 and 15 m/s as printed there (0.52 / 0.72,
+    the braked winch 0.27 / 0.37; within 0.01 of the printed two digits)."""
+    p = load_params("tcom_32m")
+    zeta = {}
+    for name in ("shipped", "passive"):
+        rec = evaluate_policy(name, "damping", params=p)["scenarios"]["recover"]["episodes"]
+        zeta[name] = {e["wind_speed"]: e["pendulum_zeta"] for e in rec}
+    assert (zeta["shipped"][10.0], zeta["shipped"][15.0]) == pytest.approx((0.52, 0.72),
+                                                                          abs=0.01)
+    assert (zeta["passive"][10.0], zeta["passive"][15.0]) == pytest.approx((0.27, 0.37),
+                                                                          abs=0.01)
+
+
 def load_params_from_text(text):
     return params_from_dict(tomllib.loads(text))
