@@ -11,6 +11,13 @@ Geometric similarity with linear factor s = (V / V_0)^(1/3) and the same gas, fa
   s^3), and the winch's force limits and drivetrain mass with s^3;
 - the tether length is set independently; the winch's length limits keep their baseline
   proportions to it (min 0.5 L, max 4/3 L, line on the drum = max).
+
+The strength law holds the margin of the zero-wind load, not of the wind load: drag grows with
+s^2 U^2 against a strength in s^3, so a scaled-down aerostat has less margin in strong wind.
+Winch tension at the trim over tether strength at 0 / 15 / 25 / 35 m/s: baseline 0.07 / 0.11 /
+0.21 / 0.38; volume x 0.1 on 100 m 0.07 / 0.17 / 0.42 / 0.82; volume x 10 on 1000 m 0.07 /
+0.08 / 0.12 / 0.19 (``envs.batch.trim_table``). In a random-winch soak at 25-35 m/s the x 0.1
+aerostat breaks its tether; check the strength of a scaled-down tether against your winds.
 """
 
 from __future__ import annotations
