@@ -25,21 +25,24 @@ def test_readme_shipped_policy_loop_is_the_evaluators_rollout():
     ``predict``."""
     from aerostat_gym.agents.returns import task_returns
 
-    text = (Path(__file__).parent.parent / "README.md").read_text()
-    section = text.split("**Running it yourself.**", 1)[1]
     namespace: dict = {}
-    exec(compile(re.search(r"```python\n(.*?)```", section, flags=re.S).group(1), "README.md",
-                 "exec"), namespace)  # noqa: S102
+    exec(compile(_python_block("**Running it yourself.**"), "README.md", "exec"),
+         namespace)  # noqa: S102
     assert namespace["truncated"] and not namespace["terminated"]
     reference = task_returns("shipped", "TetheredAerostatRealistic-v0", [0])[0]
     assert namespace["episode_return"] == pytest.approx(reference, rel=1e-9)
 
 
+def _python_block(after: str) -> str:
+    """The README's first python block after the text ``after``."""
+    text = (Path(__file__).parent.parent / "README.md").read_text()
+    section = text.split(after, 1)[1]
+    return re.search(r"```python\n(.*?)```", section, flags=re.S).group(1)
+
+
 def _sb3_example() -> str:
     """The README's SB3 example: the python block under "A short SB3 run"."""
-    text = (Path(__file__).parent.parent / "README.md").read_text()
-    section = text.split("**A short SB3 run.**", 1)[1]
-    return re.search(r"```python\n(.*?)```", section, flags=re.S).group(1)
+    return _python_block("**A short SB3 run.**")
 
 
 def test_readme_sb3_example_is_short_and_complete():
