@@ -122,7 +122,9 @@ class TetheredAerostatEnv(gym.Env):
     numerical failure (``info["failure"]``: ``"nonfinite_state"``, ``"nonfinite_output"`` or
     ``"numerical_divergence"``, a finite state beyond every physical bound, see
     :func:`aerostat_gym.sim.events.diverged`; the observation is that of the last good state;
-    no exception). ``info["termination"]`` names the reason. Truncated by the time limit set at
+    no exception). A break, strike or limit is re-run with finer integration steps before it
+    ends the episode: one they do not reproduce goes on from their state
+    (:func:`aerostat_gym.envs.kernel._resolve`). ``info["termination"]`` names the reason. Truncated by the time limit set at
     registration (600 steps = 120 s at the default 0.2 s control step) or passed to
     ``gym.make(..., max_episode_steps=N)``: the turbulence fields are periodic and read modulo
     their length, so episodes of any length are served.

@@ -167,10 +167,12 @@ def _step_one(x, x_prev, t, a, a_prev, braked, quiet, p, wp, wf, w, cfg, x_trim,
                        scale, lo, hi, obs, terms), brake, quiet, 0.0
     code = E.step_outcome(x, t1, p, stats[0], cfg[C_GROUND], cfg[C_HORIZON])
     if code == E.TETHER_BREAK or code == E.GROUND_STRIKE or code == E.LENGTH_LIMIT:
-        if not _confirmed(code, x, stats[0], x_prev, t, u, p, wp, wf, w, cfg):
-            code = E.DIVERGED
-        observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)  # refill w
-    if code == E.DIVERGED:
+        code = _resolve(code, x, x_prev, t, u, p, wp, wf, w, cfg, stats)
+        # refill w, and observe the refined state when the step was re-integrated
+        if not math.isfinite(observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi,
+                                     obs)):
+            code = E.NONFINITE_OUTPUT
+    if code == E.DIVERGED or code == E.NONFINITE_OUTPUT:
         return _failed(code, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi,
                        obs, terms), brake, quiet, 0.0
     R.reward_terms(obs, a, a_prev, stats[0], code, cfg[C_WEIGHTS:], cfg[C_SWL],
@@ -182,36 +184,102 @@ def _step_one(x, x_prev, t, a, a_prev, braked, quiet, p, wp, wf, w, cfg, x_trim,
 #: to this fraction of the state's largest entry (integration error is far smaller; an
 #: integrator past its stability step misses by orders of magnitude)
 REPRODUCE_TOL = 1e-3
+#: Finest re-run of a terminating step that half the step does not reproduce: the integration
+#: step over 2**MAX_REFINE (3 ms for the semi-implicit 50 ms)
+MAX_REFINE = 4
 
 
 @njit(**_JIT)
-def _confirmed(code, x, peak, x_prev, t, u, p, wp, wf, w, cfg):
-    """Re-run the control step from x_prev with half the integration step: a physical event
-    (tether break, ground strike, length limit) is reproduced (the same event, or an end state
-    within REPRODUCE_TOL, and for a break a peak tension within a factor of 2); an integrator
-    past its stability step is not (it is stable at half the step, or blows up differently).
-    Runs only on a terminating step."""
-    half = cfg.copy()
-    half[C_RK4_SAFETY] *= 0.5
-    half[C_SI_DT] *= 0.5
-    half[C_STEP] *= 0.5
-    x2 = x_prev.copy()
-    stats = np.empty(2)
+def _rerun(level, x_out, x_prev, t, u, p, wp, wf, w, cfg, stats):
+    """The control step from x_prev again, at the integration step over 2**level, into x_out
+    and stats; returns its outcome code (NONFINITE when the integration fails)."""
+    fine = cfg.copy()
+    shrink = 0.5 ** level
+    fine[C_RK4_SAFETY] *= shrink
+    fine[C_SI_DT] *= shrink
+    fine[C_STEP] *= shrink
+    x_out[:] = x_prev
     stats[0] = 0.0
     stats[1] = np.inf
-    if advance_interval(x2, t, cfg[C_DT], u, p, wp, wf, w, half, stats) == NONFINITE:
-        return False
-    if code == E.TETHER_BREAK and not 0.5 * peak <= stats[0] <= 2.0 * peak:
-        return False
-    if E.step_outcome(x2, t + cfg[C_DT], p, stats[0], cfg[C_GROUND], cfg[C_HORIZON]) == code:
-        return True
-    big = 1.0  # the event missed narrowly: physical if the end states agree
-    for i in range(x.size):
-        big = max(big, abs(x[i]))
-    for i in range(x.size):
-        if not abs(x2[i] - x[i]) <= REPRODUCE_TOL * big:
+    if advance_interval(x_out, t, cfg[C_DT], u, p, wp, wf, w, fine, stats) == NONFINITE:
+        return E.NONFINITE
+    return E.step_outcome(x_out, t + cfg[C_DT], p, stats[0], cfg[C_GROUND], cfg[C_HORIZON])
+
+
+@njit(**_JIT)
+def _same_end(a, b):
+    """End states within REPRODUCE_TOL of the larger state's largest entry (at least 1)."""
+    big = 1.0
+    for i in range(a.size):
+        big = max(big, abs(a[i]), abs(b[i]))
+    for i in range(a.size):
+        if not abs(a[i] - b[i]) <= REPRODUCE_TOL * big:
             return False
     return True
+
+
+@njit(**_JIT)
+def _gap(a, b):
+    """Largest entry of |a - b|."""
+    g = 0.0
+    for i in range(a.size):
+        g = max(g, abs(a[i] - b[i]))
+    return g
+
+
+#: Largest ratio |x(h) - x(h/2)| / |x(h/2) - x(h/4)| of a step that is merely inaccurate at h:
+#: a converging first-order step halves its error with the step (ratio 2; the semi-implicit
+#: scheme, and RK4 too once slack elements or the brake make the response non-smooth), here
+#: with a margin of 2. A step past its stability bound, or one from a state an unstable step
+#: has already corrupted, misses by more (RK4 at 1.4 times its bound: 5.5-6.5).
+ERROR_RATIO_LIMIT = 4.0
+
+
+@njit(**_JIT)
+def _resolve(code, x, x_prev, t, u, p, wp, wf, w, cfg, stats):
+    """Decide a terminating control step (tether break, ground strike, length limit) by
+    re-running it from x_prev with finer integration steps. Returns the outcome code; x and
+    stats hold the state and tension statistics the episode goes on from. Runs only on a
+    terminating step.
+
+    - Half the step reproduces the event (the same event, for a break with a peak tension
+      within a factor of 2, or an end state within REPRODUCE_TOL): the event is physical and
+      the step stands.
+    - Half the step fails, or (for a break) its peak tension differs by more than a factor of
+      2: the integrator was past its stability step (it is stable at half the step, or blows up
+      differently): DIVERGED.
+    - The coarse step's difference from half the step is more than ERROR_RATIO_LIMIT times
+      half the step's difference from a quarter: not an inaccurate step but an unstable one
+      (or one from a state an unstable step has corrupted): DIVERGED.
+    - Otherwise the coarse step misjudged the response (typically a tension peak near the
+      strength overshot by a few per cent in a violent excursion): the step is halved again
+      until two successive halvings agree on the outcome, and the finer of the two stands,
+      event or not (no event: the episode goes on from the refined state). No agreement by
+      MAX_REFINE halvings: DIVERGED.
+    """
+    peak, least = stats[0], stats[1]
+    coarse = np.empty(x.size)
+    fine = np.empty(x.size)
+    got = _rerun(1, coarse, x_prev, t, u, p, wp, wf, w, cfg, stats)
+    if got == E.NONFINITE or got == E.DIVERGED:
+        return E.DIVERGED
+    if code == E.TETHER_BREAK and not 0.5 * peak <= stats[0] <= 2.0 * peak:
+        return E.DIVERGED
+    if got == code or _same_end(coarse, x):
+        stats[0], stats[1] = peak, least  # the original step stands (x untouched)
+        return code
+    coarse_error = _gap(x, coarse)
+    for level in range(2, MAX_REFINE + 1):
+        finer = _rerun(level, fine, x_prev, t, u, p, wp, wf, w, cfg, stats)
+        if finer == E.NONFINITE or finer == E.DIVERGED:
+            return E.DIVERGED
+        if level == 2 and not coarse_error <= ERROR_RATIO_LIMIT * _gap(coarse, fine):
+            return E.DIVERGED
+        if finer == got:
+            x[:] = fine
+            return finer
+        got = finer
+    return E.DIVERGED
 
 
 @njit(**_JIT)

@@ -16,9 +16,10 @@ from ..physics.state import S_LENGTH, S_P, S_REEL, S_VX, S_X, S_Z, aerostat_offs
 #: Outcome codes of a control step. DIVERGED and NONFINITE_OUTPUT are numerical failures, like
 #: NONFINITE: the integration, not the physics, has gone wrong. DIVERGED is a finite state
 #: beyond every physical bound (:func:`diverged`) or, in the environments, a terminating event
-#: (break, ground strike, length limit) that half the integration step does not reproduce
-#: (:func:`aerostat_gym.envs.kernel._confirmed`): an integrator past its stability step, or a
-#: step too coarse to resolve a tension peak near the strength.
+#: (break, ground strike, length limit) that finer integration steps show to come from an
+#: integrator past its stability step, or that they cannot settle
+#: (:func:`aerostat_gym.envs.kernel._resolve`). An event that only the coarse step sees (a
+#: tension peak near the strength overshot) is not an outcome: the step is re-integrated.
 (RUNNING, NONFINITE, TETHER_BREAK, GROUND_STRIKE, LENGTH_LIMIT, FIELD_END, DIVERGED,
  NONFINITE_OUTPUT) = range(8)
 #: Reason strings (``info["termination"]``, ``info["failure"]``, ``info["truncation"]``).
