@@ -1,13 +1,18 @@
 """aerostat-gym: tethered-aerostat simulator, linear stability analysis and Gymnasium testbed."""
 
-from .registration import ENV_ID, register
+from . import jit_cache
+
+jit_cache.refresh()  # before any compiled function loads its cache: see jit_cache
+
+from .registration import ENV_ID, register  # noqa: E402
 
 __version__ = "0.7.3"
 #: Oldest version whose registered tasks (dynamics, wind, reward, winch logic) and residual
 #: command path this version reproduces: a policy trained by it or later runs here as it was
 #: trained (0.5 added a baseline and stricter loading, 0.6 training options and an optional
 #: per-episode turbulence draw, 0.7 training options, 0.7.3 re-integrates a terminating step
-#: that used to end as a numerical failure; every 0.4 report row reproduced).
+#: that used to end as a numerical failure and stops an over-hauled drum at the end of the
+#: line instead of ending the episode there; every 0.4 report row reproduced).
 TASKS_COMPATIBLE_SINCE = "0.4.0"
 
 register()

@@ -169,6 +169,23 @@ def test_3_overhauled_drum_never_exceeds_its_rated_speed():
     assert paid == pytest.approx(vmax * 30.0, abs=vmax * 2.5)  # lag: <= tau + v/a_max = 2.3 s
 
 
+def test_3_overhauled_drum_stops_at_the_end_of_the_line():
+    """Paying out over-hauled toward max_length = 310 m (from 300 m): the drum follows the
+    stopping profile (the brake takes what the motor cannot), so the length never passes
+    310 m (1e-9 m) and ends within 1 cm of it; the episode never ends on the length limit
+    (before, the drum ran out at its rated 1 m/s and passed the limit at once)."""
+    env = _high_wind_env(overrides={"winch.max_length": 310.0, "winch.total_line_length": 310.0})
+    env.reset(seed=0)
+    lay = env._batch.layout
+    lengths = []
+    for _ in range(200):  # 40 s
+        _, _, terminated, _, info = env.step(np.array([1.0], np.float32))
+        assert not terminated, info
+        lengths.append(env.state[lay.winch_length])
+    assert max(lengths) <= 310.0 + 1e-9
+    assert lengths[-1] > 310.0 - 0.01
+
+
 def test_3_brake_rule_overhaul_closed_form():
     from aerostat_gym.sim.winch import brake_rule
 

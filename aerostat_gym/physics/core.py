@@ -698,11 +698,15 @@ def _winch(x, u, p, Tw, dx, o):
     part makes the closed loop critically damped at the limit (tau d'' + d' + d / (4 tau) = 0),
     so the drum stops at the limit without overshoot when the motor has authority.
 
-    Over-hauled (the motor force saturated), the drum speed never exceeds its rating v_max:
-    the overspeed brake takes whatever the motor cannot, so that |v_w'| <= (v_max -+ v_w) / tau,
-    the bound the unsaturated speed loop obeys anyway (v_s is within +-v_max); the drum then
-    approaches v_max with the loop's time constant and a drum found beyond it returns to it. The holding brake that stops an
-    over-hauled drum against a reel-in or hold command is supervisory
+    Over-hauled (the motor force saturated), the drum speed never exceeds what the set-point
+    may ask for: the rated speed v_max, and near a length limit the stopping profile's v_cap.
+    The brake takes whatever the motor cannot, so that v_w' stays within
+    ((-v_lo - v_w) / tau, (v_hi - v_w) / tau), v_hi and v_lo the pay-out and reel-in speeds
+    the set-point is clipped to, the bound the unsaturated speed loop obeys anyway; the drum
+    then follows the same critically damped approach and stops at the limit, and a drum found
+    beyond the bound returns to it. (Without the profile in this bound, a load that over-hauls
+    the motor near max_length ran the drum past it at up to v_max.) The holding brake that
+    stops an over-hauled drum against a reel-in or hold command is supervisory
     (:func:`aerostat_gym.sim.winch.brake_rule`): it arrives here as u[1] != 0.
     """
     L, v = x[o + S_LENGTH], x[o + S_REEL]
@@ -711,20 +715,20 @@ def _winch(x, u, p, Tw, dx, o):
         dx[o + S_REEL] = 0.0
         return
     vmax, a_max, tau = p[P_W_VMAX], p[P_W_AMAX], p[P_W_TAU]
-    vs = min(max(u[0], -vmax), vmax)
     d_hi = max(p[P_W_LMAX] - L, 0.0)
     d_lo = max(L - p[P_W_LMIN], 0.0)
-    vs = min(vs, min(d_hi / (4.0 * tau), math.sqrt(a_max * d_hi)))
-    vs = max(vs, -min(d_lo / (4.0 * tau), math.sqrt(a_max * d_lo)))
+    v_hi = min(vmax, d_hi / (4.0 * tau), math.sqrt(a_max * d_hi))
+    v_lo = min(vmax, d_lo / (4.0 * tau), math.sqrt(a_max * d_lo))
+    vs = min(max(u[0], -v_lo), v_hi)
     a_des = min(max((vs - v) / tau, -a_max), a_max)
     m_eq = p[P_W_MEQ]
     fr = winch_friction(v, p)
     Fm = min(max(m_eq * a_des - Tw + fr, -p[P_W_FMAX]), p[P_W_FMAX])
     dv = (Tw + Fm - fr) / m_eq
     if abs(Fm) >= p[P_W_FMAX]:
-        # motor saturated: the overspeed brake takes what the motor cannot, so the drum
-        # approaches its rated speed no faster than the speed loop would (never beyond it)
-        dv = min(max(dv, (-vmax - v) / tau), (vmax - v) / tau)
+        # motor saturated: the brake takes what the motor cannot, so the drum approaches the
+        # set-point's speed bound no faster than the speed loop would (never beyond it)
+        dv = min(max(dv, (-v_lo - v) / tau), (v_hi - v) / tau)
     dx[o + S_LENGTH] = v
     dx[o + S_REEL] = dv
 
