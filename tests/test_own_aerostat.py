@@ -442,3 +442,57 @@ def test_shipped_policy_carries_to_the_32m_class_as_the_readme_says():
 
 def load_params_from_text(text):
     return params_from_dict(tomllib.loads(text))
+
+
+def test_observation_limits_and_metrics_follow_a_heavy_aerostat():
+    """100 x the baseline's volume on 2000 m: its trim tension (about 220 kN at the winch at
+    10 m/s) is above the 100 kN limit sized for the baseline. The tension channels' limits are
+    twice its strength, the position and length channels its winch's reach and range (the
+    baseline's space is the table's); the observed and the evaluator's tension are the state's
+    winch tension (float32 rounding), not the clip."""
+    from aerostat_gym.agents.evaluate import run_scenario
+    from aerostat_gym.envs import TetheredAerostatEnv
+    from aerostat_gym.envs.spaces import CHANNELS, OBS_INDEX, OBS_TENSION, bounds
+
+    base_lo, base_hi = bounds(0)
+    lo, hi = bounds(0, load_params())
+    assert np.array_equal(lo, base_lo) and np.array_equal(hi, base_hi)
+    p = scale_aerostat(load_params(), volume_factor=100.0, tether_length=2000.0, n_elements=6)
+    lo, hi = bounds(0, p)
+    scale = {c.name: c.scale for c in CHANNELS}
+    assert hi[OBS_INDEX["tension"]] == pytest.approx(2 * p.tether.strength / 1e4, rel=1e-6)
+    assert lo[OBS_INDEX["dtension"]] == pytest.approx(-2 * p.tether.strength / 1e3, rel=1e-6)
+    assert hi[OBS_INDEX["dx"]] == pytest.approx(p.winch.max_length / scale["dx"], rel=1e-6)
+    span = p.winch.max_length - p.winch.min_length
+    assert hi[OBS_INDEX["dlength"]] == pytest.approx(span / scale["dlength"], rel=1e-6)
+    env = TetheredAerostatEnv(params=p, wind_speed=(10.0, 10.0), turbulence="none",
+                              perturbation="none")
+    obs, _ = env.reset(seed=0)
+    T_w = Model(p).end_tensions(env.state)[1]
+    assert T_w > 2.0e5
+    assert obs[OBS_TENSION] * CHANNELS[OBS_TENSION].scale == pytest.approx(T_w, rel=1e-6)
+    ep = run_scenario(load_policy("passive"), "recover", [10.0], [0], env_kwargs={"params": p})
+    trim_T = Model(p).end_tensions(find_equilibrium(p, 10.0).x)[1]
+    assert np.nanmax(ep.tension) > trim_T > 2.0e5  # the swing loads the tether above its trim
+
+
+def test_schedules_stop_where_the_winch_motor_cannot_hold_the_trim():
+    """0.01 x the baseline's volume on 40 m: its winch motor (8 kN x 0.01 = 80 N) cannot hold
+    the trim from about 12 m/s. The LQR, modal and LQG schedules keep the design speeds whose
+    trim winch tension is at most the motor force (the next speed's is above it) and run there;
+    a motor that holds no trim at all is a clear design error."""
+    from aerostat_gym.agents.lqg import LQGSchedule
+    from aerostat_gym.agents.lqr import LQRDesignError, held_trims
+    from aerostat_gym.agents.modal import ModalSchedule
+
+    p = scale_aerostat(load_params(), volume_factor=0.01, tether_length=40.0, n_elements=4)
+    fmax = p.winch.max_motor_force
+    held = held_trims(p, np.arange(2.0, 17.0))
+    top = held[-1][0]
+    assert all(eq.summary["winch_tension_N"] <= fmax for _, eq in held)
+    assert find_equilibrium(p, top + 1.0).summary["winch_tension_N"] > fmax
+    assert 8.0 <= top < 16.0
+    for schedule in (LQRSchedule(p), ModalSchedule(p), LQGSchedule(p)):
+        assert schedule.speeds[-1] == top and schedule.speeds[0] == 2.0
+    with pytest.raises(LQRDesignError, match="winch.max_motor_force"):
+        held_trims(p.replace(**{"winch.max_motor_force": 1.0}), [5.0, 6.0])

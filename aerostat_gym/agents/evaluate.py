@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..envs.config import DEFAULT_WIND_RANGE
-from ..envs.spaces import CHANNELS, N_OBS, OBS_TENSION
+from ..envs.spaces import N_OBS
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import dumps_toml, load_params
 from .metrics import response_metrics
@@ -220,8 +220,9 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
 
     The environment's wind-speed range is the training range DEFAULT_WIND_RANGE widened to
     the requested speeds (so the suites inside it run on exactly the training environment's
-    trims and turbulence bank). The tension is recorded from the noise-free state: with
-    ``obs_noise`` the policy sees a noisy load cell, the metrics do not.
+    trims and turbulence bank). The tension is the winch tension of the state, not the load-cell
+    channel: with ``obs_noise`` the policy sees a noisy load cell, the metrics do not, and they
+    are not clipped to the observation's bounds either.
     """
     sc = SCENARIOS[scenario]
     pairs = [(u, s) for u in speeds for s in seeds]
@@ -230,7 +231,6 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
               **(env_kwargs or {}), **sc.env_kwargs}
     env = TetheredAerostatVectorEnv(num_envs=len(pairs), max_episode_steps=steps,
                                     observation="full", control_step=control_step, **kwargs)
-    noisy = env.task.obs_noise > 0.0
     obs, _ = env.reset(seed=[s for _, s in pairs],
                        options={"wind_speed": [u for u, _ in pairs]})
     b, lay = env.batch, env.batch.layout
@@ -245,12 +245,7 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
             rec[name][:, k] = np.where(alive, d[:, col], np.nan)
         rec["q"][:, k] = np.where(alive, b.state[:, iq], np.nan)
         rec["reel"][:, k] = np.where(alive, b.state[:, iv], np.nan)
-        if noisy:  # the load cell without its noise: the batch's observation recomputed
-            for i in np.flatnonzero(alive):  # (the policy already holds its noisy copy)
-                b.observe(i)
-            obs = b.obs
-        rec["tension"][:, k] = np.where(alive, obs[:, OBS_TENSION] * CHANNELS[OBS_TENSION].scale,
-                                        np.nan)
+        rec["tension"][:, k] = np.where(alive, b.winch_tensions(), np.nan)
 
     returns, ended = rollout(policy, env, obs, steps, record)
     env.close()

@@ -51,7 +51,7 @@ from ..envs.spaces import CHANNELS, N_OBS, check_obs_noise
 from ..params import Params
 from ..physics.state import StateLayout
 from ..sim import Model
-from .lqr import DEFAULT_SPEEDS, LQRDesign, design_lqr, discretize
+from .lqr import DEFAULT_SPEEDS, LQRDesign, design_lqr, discretize, held_trims
 from .modal import design_modal
 
 #: Standard observation channels the filter uses (name -> index), all longitudinal.
@@ -286,7 +286,8 @@ class LQGSchedule:
     params : Params
         Model parameters.
     speeds : array_like or None
-        Design speeds [m/s], increasing (default 2 to 16 m/s in 1 m/s steps).
+        Design speeds [m/s], increasing (default 2 to 16 m/s in 1 m/s steps); those whose
+        trim the winch motor cannot hold are dropped (:func:`~aerostat_gym.agents.lqr.held_trims`).
     dt : float
         Control step [s].
     obs_noise : float
@@ -299,15 +300,11 @@ class LQGSchedule:
 
     def __init__(self, params: Params, speeds=None, dt: float = 0.2, obs_noise: float = 0.0,
                  process_noise: dict | None = None, gains: str = "lqr"):
-        speeds = np.asarray(DEFAULT_SPEEDS if speeds is None else speeds, float).ravel()
-        if speeds.size == 0 or np.any(np.diff(speeds) <= 0) or np.any(speeds < 0):
-            raise ValueError(f"speeds must be non-negative and strictly increasing, got {speeds}")
-        designs, eq = [], None
-        for U in speeds:
-            eq = find_equilibrium(params, float(U), guess=eq)
-            designs.append(design_lqg(params, float(U), dt, obs_noise,
-                                      process_noise=process_noise, equilibrium=eq, gains=gains))
-        self.params, self.speeds, self.dt, self.designs = params, speeds, float(dt), designs
+        held = held_trims(params, DEFAULT_SPEEDS if speeds is None else speeds)
+        designs = [design_lqg(params, U, dt, obs_noise, process_noise=process_noise,
+                              equilibrium=eq, gains=gains) for U, eq in held]
+        self.params, self.dt, self.designs = params, float(dt), designs
+        self.speeds = np.array([U for U, _ in held])
         self.index = designs[0].index
         self.tables = {name: np.array([getattr(d, name) for d in designs])
                        for name in ("Ad", "Bd", "C", "L", "K")}

@@ -110,6 +110,29 @@ def schedule_speeds(wind_range: tuple[float, float]) -> np.ndarray:
     n = int(math.ceil((hi + SCHEDULE_STEP - start) / SCHEDULE_STEP - 1e-9)) + 1
     return start + SCHEDULE_STEP * np.arange(n)
 
+def held_trims(params: Params, speeds) -> list:
+    """(U, trim) at each design speed (non-negative, strictly increasing) whose trim the winch
+    motor holds: winch tension at most ``winch.max_motor_force``. Above that speed a feedback
+    design has no actuator (the over-hauled winch holds on its brake,
+    :func:`aerostat_gym.sim.winch.brake_rule`, and its linearization has no control over the
+    drum), so a schedule stops there and its gains stay those of the last held speed. Trims
+    by continuation in U. Raises LQRDesignError when the motor holds none of them."""
+    speeds = np.asarray(speeds, float).ravel()
+    if speeds.size == 0 or np.any(np.diff(speeds) <= 0) or np.any(speeds < 0):
+        raise ValueError(f"speeds must be non-negative and strictly increasing, got {speeds}")
+    fmax, held, eq = params.winch.max_motor_force, [], None
+    for U in speeds:
+        eq = find_equilibrium(params, float(U), guess=eq)
+        if eq.summary["winch_tension_N"] > fmax:
+            break
+        held.append((float(U), eq))
+    if not held:
+        raise LQRDesignError(f"the winch motor (winch.max_motor_force = {fmax:.0f} N) cannot "
+                             f"hold the trim at any design speed from {speeds[0]:g} m/s: no "
+                             "feedback design")
+    return held
+
+
 #: Long-period/short-period modes reported by :meth:`LQRDesign.summary`.
 NAMED_MODES = ("pendulum", "pitching", "axial spring")
 
@@ -439,7 +462,8 @@ class LQRSchedule:
 
     Attributes
     ----------
-    speeds : (S,). gains : (S, 6n+9). trims : (S, 6n+8). dt, weights, subset : design settings
+    speeds : (S,), the design speeds whose trim the winch motor holds (:func:`held_trims`).
+    gains : (S, 6n+9). trims : (S, 6n+8). dt, weights, subset : design settings
     (``subsets`` per speed). pendulum_zeta, pitch_zeta : (S, 2) open/closed-loop predictions.
     build_time_s : wall time of the build (0 for a loaded table). designs : the
     :class:`LQRDesign` objects (only for a table built in this process).
@@ -456,18 +480,13 @@ class LQRSchedule:
         """Design at every speed (``design_at(U, equilibrium)``, trims by continuation in U)
         and fill the tables; returns the designs. Subclasses with another design rule (the
         modal controller) reuse it."""
-        speeds = np.asarray(DEFAULT_SPEEDS if speeds is None else speeds, float).ravel()
-        if speeds.size == 0 or np.any(np.diff(speeds) <= 0) or np.any(speeds < 0):
-            raise ValueError(f"speeds must be non-negative and strictly increasing, got {speeds}")
         t0 = time.perf_counter()
-        designs, eq = [], None
-        for U in speeds:
-            eq = find_equilibrium(params, float(U), guess=eq)
-            designs.append(design_at(float(U), eq))
+        held = held_trims(params, DEFAULT_SPEEDS if speeds is None else speeds)
+        designs = [design_at(U, eq) for U, eq in held]
         self.build_time_s = time.perf_counter() - t0
         self.params = params
         self.fingerprint = params_fingerprint(params)
-        self.speeds = speeds
+        self.speeds = np.array([U for U, _ in held])
         self.dt = float(dt)
         self.gains = np.array([d.K for d in designs])
         self.trims = np.array([d.x_trim for d in designs])

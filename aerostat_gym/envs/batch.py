@@ -13,6 +13,7 @@ import numpy as np
 
 from ..analysis.trim import TrimError
 from ..physics.integrators import scheme
+from ..physics.outputs import winch_tension
 from ..physics.packing import P_SIZE
 from ..physics.state import StateLayout, work_size
 from ..physics.wind import W_SIZE, mean_wind, set_advection
@@ -105,7 +106,7 @@ class EnvBatch:
         S = self.layout.size
         self.full_size = S if task.observation == "full" else 0
         self.obs_dim = spaces.N_OBS + (1 + S if self.full_size else 0)
-        self.obs_low, self.obs_high = spaces.bounds(self.full_size)
+        self.obs_low, self.obs_high = spaces.bounds(self.full_size, params)
         self.trims = trim_table(task)
         self.bank = self._bank()
         self.cfg = self._config(params)
@@ -206,6 +207,12 @@ class EnvBatch:
         if not math.isfinite(T_w):
             raise FloatingPointError(f"environment {i}: the state gives non-finite outputs "
                                      f"(winch tension {T_w!r})")
+
+    def winch_tensions(self) -> np.ndarray:
+        """Winch tension [N] of every slot's state, noise-free and unclipped (from the work
+        arrays, which every step, reset and restore fills for the slot's current state)."""
+        return np.array([winch_tension(self.state[i], self.packed[i], self.work[i])
+                         for i in range(self.num_envs)])
 
     #: Per-slot arrays that make up the simulator state of one environment.
     SLOT_ARRAYS = ("state", "trim_state", "trim_tension", "time", "action", "action_prev",

@@ -91,10 +91,31 @@ def observation_table(full_state_size: int = 0) -> list[dict]:
     return rows
 
 
-def bounds(full_state_size: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """float32 (low, high) of the observation space."""
+#: Channels whose clip limit grows with the configured aerostat, and the SI limit each needs:
+#: positions reach the winch's longest line, the length channel its whole range, the tension
+#: channels twice the tether strength (a break is at 1x). A limit never shrinks below the
+#: table's (sized for [LN02]'s baseline, whose space is therefore unchanged).
+SIZED_CHANNELS = {
+    "dx": lambda p: p.winch.max_length,
+    "dy": lambda p: p.winch.max_length,
+    "dz": lambda p: p.winch.max_length,
+    "dlength": lambda p: p.winch.max_length - p.winch.min_length,
+    "tension": lambda p: 2.0 * p.tether.strength,
+    "dtension": lambda p: 2.0 * p.tether.strength,
+}
+
+
+def bounds(full_state_size: int = 0, params=None) -> tuple[np.ndarray, np.ndarray]:
+    """float32 (low, high) of the observation space; with ``params``, the limits of
+    :data:`SIZED_CHANNELS` widened to that aerostat's reach, length range and strength."""
     lo = [c.low for c in CHANNELS]
     hi = [c.high for c in CHANNELS]
+    if params is not None:
+        for i, c in enumerate(CHANNELS):
+            if c.name in SIZED_CHANNELS:
+                limit = max(c.high, SIZED_CHANNELS[c.name](params) / c.scale)
+                hi[i] = limit
+                lo[i] = -limit if c.low < 0.0 else c.low
     if full_state_size:
         lo += [0.0] + [-FULL_STATE_LIMIT] * full_state_size
         hi += [FULL_STATE_LIMIT] * (1 + full_state_size)
