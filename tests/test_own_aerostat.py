@@ -496,3 +496,24 @@ def test_schedules_stop_where_the_winch_motor_cannot_hold_the_trim():
         assert schedule.speeds[-1] == top and schedule.speeds[0] == 2.0
     with pytest.raises(LQRDesignError, match="winch.max_motor_force"):
         held_trims(p.replace(**{"winch.max_motor_force": 1.0}), [5.0, 6.0])
+
+
+@pytest.mark.parametrize("factor", [0.01, 0.1, 10.0])
+def test_scaling_laws(factor):
+    """Geometric similarity with s = factor^(1/3) (aerostat_gym.scaling): lengths x s, areas
+    x s^2, masses, volumes and the tether's strength x s^3, inertias x s^5 (rel 1e-12); the
+    semi-implicit step x sqrt(s) below the source's size, unchanged above it."""
+    base = load_params()
+    p = scale_aerostat(base, volume_factor=factor, tether_length=250.0)
+    s = factor ** (1.0 / 3.0)
+    pairs = [(p.aerostat.length, base.aerostat.length * s),
+             (p.fins.planform_area, base.fins.planform_area * s**2),
+             (p.aerostat.volume, base.aerostat.volume * s**3),
+             (p.aerostat.mass, base.aerostat.mass * s**3),
+             (p.tether.strength, base.tether.strength * s**3),
+             (p.aerostat.Iyy, base.aerostat.Iyy * s**5),
+             (p.simulation.semi_implicit_dt,
+              base.simulation.semi_implicit_dt * min(1.0, math.sqrt(s)))]
+    for got, want in pairs:
+        assert got == pytest.approx(want, rel=1e-12)
+    assert p.tether.length == 250.0 and p.winch.max_length == pytest.approx(250.0 * 4 / 3)
