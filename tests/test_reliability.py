@@ -296,13 +296,10 @@ def test_6_rk4_past_its_stability_step_is_a_numerical_failure():
     assert info["failure"] == info["termination"]
 
 
-def _kicked_baseline_step(strength=None):
+def _kicked_baseline_step():
     """A pitch-rate kick of 3 rad/s on the trim at 10 m/s, 8 control steps later: a step whose
     peak tension the 50 ms semi-implicit step overshoots (a few per cent above the finer
-    steps'). Returns the saved state there (``strength`` [N] set in its packed parameters,
-    past the loader's checks: the kernel's break test reads it there)."""
-    from aerostat_gym.physics.packing import P_STRENGTH
-
+    steps'). Returns the saved state there."""
     env = TetheredAerostatEnv(wind_speed=(10.0, 10.0), n_elements=5, **QUIET)
     env.reset(seed=0)
     saved = env.get_state()
@@ -310,10 +307,17 @@ def _kicked_baseline_step(strength=None):
     env.set_state(saved)
     for _ in range(8):
         env.step(np.zeros(1, np.float32))
-    saved = env.get_state()
-    if strength is not None:
-        saved["packed"][P_STRENGTH] = strength
-    return saved
+    return env.get_state()
+
+
+def _with_strength(saved, strength):
+    """``saved`` with the tether strength [N] set in its packed parameters, past the loader's
+    checks (the kernel's break test reads it there)."""
+    from aerostat_gym.physics.packing import P_STRENGTH
+
+    packed = saved["packed"].copy()
+    packed[P_STRENGTH] = strength
+    return {**saved, "packed": packed}
 
 
 def _step_at(saved, si_dt):
@@ -330,8 +334,8 @@ def _step_at(saved, si_dt):
 def test_6_a_break_only_the_coarse_step_sees_is_re_integrated_not_a_failure():
     """The 50 ms step peaks above a strength that 25, 12.5, 6.25 and 3.1 ms all stay under:
     the step is not a break and not a numerical failure; the episode goes on from the 12.5 ms
-    state (25 and 12.5 ms are the first two successive halvings that agree), bit for bit. With the strength
-    under every step's peak it is a break, at the 50 ms state."""
+    state (25 and 12.5 ms are the first two successive halvings that agree), bit for bit.
+    With the strength under every step's peak it is a break, at the 50 ms state."""
     base = _kicked_baseline_step()
     dt = load_params().simulation.semi_implicit_dt
     runs = [_step_at(base, dt * 0.5**k) for k in range(5)]
@@ -339,12 +343,12 @@ def test_6_a_break_only_the_coarse_step_sees_is_re_integrated_not_a_failure():
     finer = max(peaks[1:])
     assert peaks[0] > 1.02 * finer  # the overshoot this test is about (405 N against 391 N)
     between = 0.5 * (peaks[0] + finer)
-    x, peak, terminated, info = _step_at(_kicked_baseline_step(between), dt)
+    x, peak, terminated, info = _step_at(_with_strength(base, between), dt)
     assert not terminated and "termination" not in info
     np.testing.assert_array_equal(x, runs[2][0])
     assert peak == runs[2][1]
     below = 0.5 * min(peaks)
-    x, peak, terminated, info = _step_at(_kicked_baseline_step(below), dt)
+    x, peak, terminated, info = _step_at(_with_strength(base, below), dt)
     assert terminated and info["termination"] == "tether_break" and "failure" not in info
     np.testing.assert_array_equal(x, runs[0][0])
     assert peak == peaks[0]

@@ -110,6 +110,7 @@ def schedule_speeds(wind_range: tuple[float, float]) -> np.ndarray:
     n = int(math.ceil((hi + SCHEDULE_STEP - start) / SCHEDULE_STEP - 1e-9)) + 1
     return start + SCHEDULE_STEP * np.arange(n)
 
+
 def held_trims(params: Params, speeds) -> list:
     """(U, trim) at each design speed (non-negative, strictly increasing) whose trim the winch
     motor holds: winch tension at most ``winch.max_motor_force``. Above that speed a feedback

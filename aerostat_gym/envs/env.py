@@ -124,7 +124,8 @@ class TetheredAerostatEnv(gym.Env):
     :func:`aerostat_gym.sim.events.diverged`; the observation is that of the last good state;
     no exception). A break, strike or limit is re-run with finer integration steps before it
     ends the episode: one they do not reproduce goes on from their state
-    (:func:`aerostat_gym.envs.kernel._resolve`). ``info["termination"]`` names the reason. Truncated by the time limit set at
+    (:func:`aerostat_gym.envs.kernel._resolve`). ``info["termination"]`` names the reason.
+    Truncated by the time limit set at
     registration (600 steps = 120 s at the default 0.2 s control step) or passed to
     ``gym.make(..., max_episode_steps=N)``: the turbulence fields are periodic and read modulo
     their length, so episodes of any length are served.
@@ -200,6 +201,15 @@ class TetheredAerostatEnv(gym.Env):
       as 1.0).
     - v0 (aerostat-gym 0.6; dynamics, observation and reward unchanged): ``turbulence_mix``, a
       per-episode intensity-class draw (absent, every episode is as in 0.5).
+    - v0 (aerostat-gym 0.7.2; dynamics, observation and reward unchanged): an unknown argument
+      is a ``TaskError`` naming it and the nearest accepted one (was a ``TypeError``).
+    - v0 (aerostat-gym 0.7.3; every 0.4 evaluation and the baseline's observation space
+      unchanged): a terminating step that half the integration step does not reproduce is
+      re-integrated at finer steps and, if they show no event, the episode goes on from their
+      state (was: ``numerical_divergence``); an over-hauled winch drum paying out stops at
+      ``winch.max_length`` (was: ran past it, ending the episode on the length limit); the
+      clip limits of the position, length and tension channels grow with the configured
+      winch's reach and tether's strength (were the baseline's 400 m, 250 m and 100 kN).
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
