@@ -6,6 +6,7 @@ Measured values quoted in the docstrings are for the shipped baseline parameters
 
 import argparse
 import json
+import math
 
 import numpy as np
 import pytest
@@ -35,6 +36,7 @@ from aerostat_gym.analysis.reference import (
     reference_periods,
     table2,
     tether_harmonic_frequency,
+    tether_mass_periods,
 )
 from aerostat_gym.analysis.sensitivity import default_knobs, solve_for_period, stability_figures
 from aerostat_gym.analysis.trim import find_equilibrium
@@ -172,6 +174,25 @@ def test_reference_periods_closed_form(base):
     d = base.derived
     w1 = tether_harmonic_frequency(1, 300.0, d.net_lift, d.mass_per_length)
     assert tether_harmonic_frequency(3, 300.0, d.net_lift, d.mass_per_length) == pytest.approx(3 * w1)
+
+
+def test_tether_mass_periods_closed_form(base):
+    """With the tether's mass: the baseline's pendulum 44.05 s, lateral 59.27 s, axial spring
+    2.945 s, 1st harmonic 1.810 s (rel 1e-3: a 7.1 kg tether under 2645 N lengthens each by
+    0.2-1 %); a tether of a millionth of the density gives reference_periods (rel 1e-6); the
+    harmonic's period grows as 1 / sqrt(mean tension) (exact)."""
+    got = tether_mass_periods(base)
+    for key, want in (("long_pendulum", 44.05), ("lat_pendulum", 59.27),
+                      ("axial_spring", 2.945), ("tether_1st", 1.810)):
+        assert got[key] == pytest.approx(want, rel=1e-3), key
+    light = base.replace(**{"tether.density": base.tether.density * 1e-6})
+    ref = reference_periods(light)
+    for key, value in tether_mass_periods(light).items():
+        assert value == pytest.approx(ref[key], rel=1e-6), key
+    d = base.derived
+    mean = d.net_lift - d.mass_per_length * base.environment.g * base.tether.length / 2
+    assert got["tether_1st"] / reference_periods(base)["tether_1st"] == pytest.approx(
+        math.sqrt(d.net_lift / mean), rel=1e-12)
 
 
 @pytest.fixture(scope="module")

@@ -5,8 +5,9 @@ different volume, tether length, element count and trim pitch), each written to 
 passed with ``--config``. Checks, with their tolerances:
 
 - zero-wind tensions: top = B - m g, winch = B - m g - mu L g (rel 1e-6);
-- Table 2 theory column = an independent closed form (rel 1e-9), and every linear period within
-  the band of the README ("Your own aerostat") of its own closed form;
+- Table 2 theory columns = independent closed forms, massless and with the tether's mass
+  (rel 1e-9), and every linear period within the band of the README ("Your own aerostat") of
+  its own tether-mass closed form, on far-from-baseline aerostats too;
 - the paper's columns only for the paper's case, and no baseline number in other outputs;
 - Figure 8 run on the configured length; every mode stable over the sweep;
 - an LQR whose nonlinear closed-loop pendulum damping matches its linear prediction (rel 20 %);
@@ -39,7 +40,7 @@ from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.analysis.figures import family_values, figure8_data
 from aerostat_gym.analysis.linear import ACTUATORS, U_FREE, input_jacobian
 from aerostat_gym.analysis.modes import analyse, wind_sweep
-from aerostat_gym.analysis.reference import THEORY_TOLERANCE_PCT
+from aerostat_gym.analysis.reference import THEORY_TOLERANCE_PCT, table2
 from aerostat_gym.analysis.sensitivity import default_knobs
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.cli import main
@@ -117,36 +118,57 @@ def test_zero_wind_tensions(case, capsys):
     _no_baseline_numbers(name, _run(capsys, ["trim", "--config", cfg, "--wind", "0"]))
 
 
-def _closed_forms(p):
-    """Independent closed forms (written out here, not taken from the package)."""
+def _closed_forms(p, with_tether_mass=False):
+    """Independent closed forms (written out here, not taken from the package). With the
+    tether's mass: a straight tether turning with the pendulum (inertia mu L^3 / 3, weight at
+    L / 2), a third of its mass on the axial spring, harmonics on its mean tension."""
     rho, g, a, t = p.environment.rho_air, p.environment.g, p.aerostat, p.tether
     net = rho * g * a.volume - a.mass * g
     mex, mey, mez = (a.mass + k * rho * a.volume for k in (a.k1, a.k3, a.k3))
     area = math.pi * t.diameter ** 2 / 4
-    L = t.length
+    L, mu = t.length, t.density * area
+    if with_tether_mass:
+        net -= mu * g * L / 2
+        mex, mey, mez = (m + mu * L / 3 for m in (mex, mey, mez))
     return {"long_pendulum": 2 * math.pi * math.sqrt(mex * L / net),
             "lat_pendulum": 2 * math.pi * math.sqrt(mey * L / net),
             "axial_spring": 2 * math.pi * math.sqrt(mez * L / (t.youngs_modulus * area)),
-            "tether_1st": 2 * L / math.sqrt(net / (t.density * area))}
+            "tether_1st": 2 * L / math.sqrt(net / mu)}
 
 
 def test_table2_against_own_closed_forms(case, capsys):
-    """table2 --config: the theory column is this aerostat's closed form (rel 1e-9); each linear
-    period lies in its README band (long 5 %, lat 30 %, axial 3 %, tether 10 %); the paper's
-    columns appear only for the paper's case."""
+    """table2 --config: the theory columns are this aerostat's closed forms, massless and with
+    the tether's mass (rel 1e-9); each linear period lies in its README band of the latter
+    (long 5 %, lat 40 %, axial 3 %, tether 10 %); the paper's columns appear only for the
+    paper's case."""
     name, p, cfg = case
     rows = json.loads(_run(capsys, ["table2", "--config", cfg, "--json"]))
-    ref = _closed_forms(p)
-    assert THEORY_TOLERANCE_PCT == {"long_pendulum": 5.0, "lat_pendulum": 30.0,
+    ref, heavy = _closed_forms(p), _closed_forms(p, with_tether_mass=True)
+    assert THEORY_TOLERANCE_PCT == {"long_pendulum": 5.0, "lat_pendulum": 40.0,
                                     "axial_spring": 3.0, "tether_1st": 10.0}
     for r in rows:
         assert r["theory_s"] == pytest.approx(ref[r["key"]], rel=1e-9), (name, r)
-        assert abs(r["linear_s"] / ref[r["key"]] - 1) * 100 <= THEORY_TOLERANCE_PCT[r["key"]], (name, r)
+        assert r["tether_mass_theory_s"] == pytest.approx(heavy[r["key"]], rel=1e-9), (name, r)
+        assert abs(r["linear_s"] / heavy[r["key"]] - 1) * 100 <= THEORY_TOLERANCE_PCT[r["key"]], (name, r)
         assert r["within_tolerance"], (name, r)
         assert ("paper_linear_s" in r) == (name == "aeros_flightcam"), (name, r)
     text = _run(capsys, ["table2", "--config", cfg])
     assert "MISS" not in text
     _no_baseline_numbers(name, text)
+
+
+@pytest.mark.parametrize("factor, length, n, key, massless_pct, mass_pct", [
+    (100.0, 2000.0, 16, "long_pendulum", 8.1, 1.4), (0.01, 40.0, 6, "lat_pendulum", 36.3, 36.2)])
+def test_table2_on_extreme_aerostats(factor, length, n, key, massless_pct, mass_pct):
+    """Far from the baseline every linear period lies in its band of the tether-mass closed
+    form. 100x on 2000 m (the tether weighs 18 % of the net lift): the longitudinal pendulum
+    is +8.1 % off the massless form, outside its 5 % band, and +1.4 % off the tether-mass
+    form. 0.01x on 40 m: the lateral pendulum, yaw-coupled at 1 m/s, +36.2 % (band 40 %).
+    Differences within 0.2 points of these measurements."""
+    rows = {r["key"]: r for r in table2(scale_aerostat(load_params(), factor, length, n))}
+    assert all(r["within_tolerance"] for r in rows.values()), rows
+    assert rows[key]["diff_pct"] == pytest.approx(massless_pct, abs=0.2), rows[key]
+    assert rows[key]["tether_mass_diff_pct"] == pytest.approx(mass_pct, abs=0.2), rows[key]
 
 
 def test_params_provenance(case, capsys):
