@@ -152,6 +152,17 @@ def linear_table2_periods(analysis) -> dict:
 #: tests/test_own_aerostat.py.
 THEORY_TOLERANCE_PCT = {"long_pendulum": 5.0, "lat_pendulum": 40.0, "axial_spring": 3.0,
                         "tether_1st": 10.0}
+#: The mode a Table 2 mode veers with when their periods come close, and the band that then
+#: applies. The axial spring and the pitching mode are both near 3 s: the tether's spring acts
+#: at the confluence point, which lies off the vertical through the CM unless the trim pitch
+#: puts it there, so the spring also turns the hull. For two coupled oscillators the uncoupled
+#: period lies between the two coupled ones (the eigenvalues of a 2x2 symmetric stiffness
+#: bracket its diagonal), so a closed form that lies between the linear pair is the coupling,
+#: not an error. Measured on the baseline's trim pitch from -10 to +10 deg: axial spring +1.7
+#: to -6.5 % off its closed form, which lies between the linear axial and pitching periods at
+#: every pitch (at +10 deg: 2.754 < 2.945 < 3.090 s).
+VEERING_PARTNER = {"axial_spring": ("long", "pitching")}
+VEERING_TOLERANCE_PCT = 10.0
 #: The sections of the parameter set that make [LN02]'s case (wind and simulation settings do
 #: not change the Table 2 periods).
 PAPER_SECTIONS = ("environment", "aerostat", "hull", "fins", "tether")
@@ -180,7 +191,8 @@ def table2(params: Params | None = None, wind_speed: float = TABLE2_WIND) -> lis
     p = params or load_params()
     theory = reference_periods(p)
     with_mass = tether_mass_periods(p)
-    linear = linear_table2_periods(analyse(p, find_equilibrium(p, wind_speed)))
+    analysis = analyse(p, find_equilibrium(p, wind_speed))
+    linear = linear_table2_periods(analysis)
     paper_case = is_paper_case(p)
     rows = []
     for key, paper in TABLE2.items():
@@ -191,6 +203,8 @@ def table2(params: Params | None = None, wind_speed: float = TABLE2_WIND) -> lis
                "tolerance_pct": THEORY_TOLERANCE_PCT[key],
                "within_tolerance": bool(abs(diff) <= THEORY_TOLERANCE_PCT[key]),
                "paper_case": paper_case}
+        if key in VEERING_PARTNER and not row["within_tolerance"]:
+            row.update(veering_allowance(key, with_mass[key], linear[key], diff, analysis))
         if paper_case:
             vs_paper = pct_diff(linear[key], paper["linear_s"])
             row.update(paper_theory_s=paper["theory_s"], paper_linear_s=paper["linear_s"],
@@ -199,6 +213,17 @@ def table2(params: Params | None = None, wind_speed: float = TABLE2_WIND) -> lis
                        within_paper_band=bool(abs(vs_paper) <= TABLE2_TOLERANCE_PCT[key]))
         rows.append(row)
     return rows
+
+
+def veering_allowance(key: str, closed: float, linear: float, diff: float, analysis) -> dict:
+    """The band of a mode outside its own band whose closed form lies between its linear
+    period and its veering partner's (:data:`VEERING_PARTNER`)."""
+    partner = analysis.find(*VEERING_PARTNER[key])
+    if partner is None or not min(linear, partner.period) <= closed <= max(linear, partner.period):
+        return {}
+    return {"veers_with": partner.label, "veering_partner_s": partner.period,
+            "tolerance_pct": VEERING_TOLERANCE_PCT,
+            "within_tolerance": bool(abs(diff) <= VEERING_TOLERANCE_PCT)}
 
 
 def format_table2(rows: list[dict], wind_speed: float = TABLE2_WIND) -> str:
@@ -215,6 +240,8 @@ def format_table2(rows: list[dict], wind_speed: float = TABLE2_WIND) -> str:
              "-" * len(head)]
     for r in rows:
         flag = "ok" if r["within_tolerance"] else "MISS"
+        if "veers_with" in r:
+            flag += f" (veers with {r['veers_with']}, {r['veering_partner_s']:.3f}s)"
         line = (f"{r['mode']:22s} {r['theory_s']:9.2f}s {r['tether_mass_theory_s']:8.2f}s "
                 f"{r['linear_s']:9.3f}s {r['diff_pct']:+7.1f} {r['tether_mass_diff_pct']:+7.1f} "
                 f"{r['tolerance_pct']:4.0f}% {flag:4s}")
