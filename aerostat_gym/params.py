@@ -369,7 +369,8 @@ def _feasibility(p: Params, d: Derived) -> None:
             f"({w.safe_working_load} N)")
 
 
-#: The semi-implicit step measured on the shipped baseline, whose hull is 18.3 m long: no
+#: The semi-implicit step measured on the shipped baseline, whose hull is 18.3 m long (both
+#: values are the baseline file's; tests/test_own_aerostat.py checks they stay so): no
 #: numerical failure in the 1,000,320-step random-action soak (README "Guarantees"). The step is
 #: bounded by the explicit aerodynamics, whose time scales shrink with the hull under Froude
 #: similarity as sqrt(length) (aerostat_gym.scaling applies the same law).
@@ -392,11 +393,11 @@ def _advise(p: Params, source: str) -> None:
         warnings.warn(
             f"{source}: simulation.semi_implicit_dt = {p.simulation.semi_implicit_dt:g} s is "
             f"longer than {advised:.3g} s, the baseline's {SEMI_IMPLICIT_REFERENCE_DT:g} s "
-            f"scaled to this {p.aerostat.length:.3g} m hull (aerostat.length; sqrt of the length ratio): episodes "
-            "in strong turbulence may end as numerical_divergence (the baseline scaled to 0.1x "
-            "its volume, severe turbulence, random reeling: 19 in 40,000 steps at 50 ms, none "
-            f"at 34 ms). Set simulation.semi_implicit_dt <= {advised:.3g}, or use "
-            "integrator='rk4'",
+            f"scaled to this {p.aerostat.length:.3g} m hull (aerostat.length; sqrt of the "
+            "length ratio): episodes in strong turbulence may end as numerical_divergence (the "
+            "baseline scaled to 0.1x its volume, severe turbulence, random reeling: 19 in "
+            "40,000 steps at 50 ms, none at 34 ms). Set simulation.semi_implicit_dt <= "
+            f"{advised:.3g}, or use integrator='rk4'",
             ParameterWarning, stacklevel=3)
 
 

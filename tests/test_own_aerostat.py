@@ -48,6 +48,8 @@ from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main
 from aerostat_gym.params import (
+    SEMI_IMPLICIT_REFERENCE_DT,
+    SEMI_IMPLICIT_REFERENCE_HULL_LENGTH,
     ParameterError,
     ParameterWarning,
     advised_semi_implicit_dt,
@@ -552,7 +554,10 @@ def test_a_small_aerostat_file_with_the_baseline_step_warns_at_load(tmp_path):
     semi-implicit step warns once at load, naming the field, its value and the advised
     0.05 sqrt(8.49 / 18.3) = 0.0341 s; the file scale_aerostat writes, and every shipped file,
     load silently. The advised step is scale_aerostat's for any factor (rel 1e-12)."""
-    small = scale_aerostat(load_params(), volume_factor=0.1, tether_length=100.0)
+    base = load_params()
+    assert (SEMI_IMPLICIT_REFERENCE_HULL_LENGTH, SEMI_IMPLICIT_REFERENCE_DT) == (
+        base.aerostat.length, base.simulation.semi_implicit_dt)
+    small = scale_aerostat(base, volume_factor=0.1, tether_length=100.0)
     assert advised_semi_implicit_dt(small) == pytest.approx(0.05 * 0.1 ** (1 / 6), rel=1e-12)
     kept = tmp_path / "kept.toml"
     kept.write_text(dumps_toml(small.replace(**{"simulation.semi_implicit_dt": 0.05})))
