@@ -12,7 +12,9 @@ __version__ = "0.7.4"
 #: trained (0.5 added a baseline and stricter loading, 0.6 training options and an optional
 #: per-episode turbulence draw, 0.7 training options, 0.7.3 re-integrates a terminating step
 #: that used to end as a numerical failure and stops an over-hauled drum at the end of the
-#: line instead of ending the episode there; every 0.4 report row reproduced).
+#: line instead of ending the episode there, 0.7.4 fades the baselines' gains below their
+#: lowest design speed, 2 m/s, under every registered task's winds; every 0.4 report row
+#: reproduced).
 TASKS_COMPATIBLE_SINCE = "0.4.0"
 
 register()

@@ -95,12 +95,15 @@ def test_lqr_adds_pendulum_damping(designs, U, factor):
 
 def test_schedule_matches_designs_at_nodes(schedule):
     """gain(U) at a table node equals that node's design to 1e-12 (absolute, gains are O(1));
-    midway it is the mean of the neighbours (1e-12); outside the table it is clamped."""
+    midway it is the mean of the neighbours (1e-12); above the table it is clamped, below it
+    the lowest node's gains fade as (U / U_0)^2 (exact), to zero at zero wind."""
     for U, d in zip(schedule.speeds, schedule.designs, strict=True):
         np.testing.assert_allclose(schedule.gain(U), d.K, rtol=0, atol=1e-12)
     np.testing.assert_allclose(schedule.gain(9.5), 0.5 * (schedule.gains[0] + schedule.gains[1]),
                                rtol=0, atol=1e-12)
-    np.testing.assert_array_equal(schedule.gain(3.0), schedule.gains[0])
+    lowest = schedule.speeds[0]
+    np.testing.assert_array_equal(schedule.gain(3.0), schedule.gains[0] * (3.0 / lowest) ** 2)
+    np.testing.assert_array_equal(schedule.gain(0.0), 0.0 * schedule.gains[0])
     np.testing.assert_array_equal(schedule.gain(30.0), schedule.gains[-1])
     batch = schedule.gain(np.array([9.0, 10.5, 11.0]))
     assert batch.shape == (3, schedule.gains.shape[1])

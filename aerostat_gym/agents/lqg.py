@@ -51,7 +51,14 @@ from ..envs.spaces import CHANNELS, N_OBS, check_obs_noise
 from ..params import Params
 from ..physics.state import StateLayout
 from ..sim import Model
-from .lqr import DEFAULT_SPEEDS, LQRDesign, design_lqr, discretize, held_trims
+from .lqr import (
+    DEFAULT_SPEEDS,
+    LQRDesign,
+    design_lqr,
+    discretize,
+    held_trims,
+    low_wind_fade,
+)
 from .modal import design_modal
 
 #: Standard observation channels the filter uses (name -> index), all longitudinal.
@@ -278,8 +285,13 @@ def design_lqg(params: Params, wind_speed: float, dt: float = 0.2, obs_noise: fl
                      modes=modes)
 
 
+#: The schedule's tables that are feedback gains (faded at low wind), not the filter's.
+FEEDBACK_TABLES = frozenset({"K", "K_integral"})
+
+
 class LQGSchedule:
-    """LQG designs over mean wind speed; every matrix interpolated linearly in U (clamped).
+    """LQG designs over mean wind speed; every matrix interpolated linearly in U (clamped; the
+    gains faded below the lowest speed, :meth:`lookup`).
 
     Parameters
     ----------
@@ -312,19 +324,24 @@ class LQGSchedule:
 
     def lookup(self, U: np.ndarray, names=None) -> dict:
         """The tables ``names`` (default every one) at the speeds U (N,), linear in U between
-        the design speeds."""
+        the design speeds; the feedback gains (K, K_integral) faded below the lowest one
+        (:func:`~aerostat_gym.agents.lqr.low_wind_fade`), the filter's tables not."""
         s = self.speeds
         U = np.asarray(U, float)
         tables = {k: self.tables[k] for k in (names or self.tables)}
         if s.size == 1:
-            return {k: np.broadcast_to(v[0], U.shape + v.shape[1:]) for k, v in tables.items()}
-        Uc = np.clip(U, s[0], s[-1])
-        i = np.clip(np.searchsorted(s, Uc, side="right") - 1, 0, s.size - 2)
-        w = (Uc - s[i]) / (s[i + 1] - s[i])
-        out = {}
-        for k, v in tables.items():
-            ww = w.reshape(w.shape + (1,) * (v.ndim - 1))
-            out[k] = (1.0 - ww) * v[i] + ww * v[i + 1]
+            out = {k: np.broadcast_to(v[0], U.shape + v.shape[1:]) for k, v in tables.items()}
+        else:
+            Uc = np.clip(U, s[0], s[-1])
+            i = np.clip(np.searchsorted(s, Uc, side="right") - 1, 0, s.size - 2)
+            w = (Uc - s[i]) / (s[i + 1] - s[i])
+            out = {}
+            for k, v in tables.items():
+                ww = w.reshape(w.shape + (1,) * (v.ndim - 1))
+                out[k] = (1.0 - ww) * v[i] + ww * v[i + 1]
+        fade = low_wind_fade(U, s[0])
+        for k in FEEDBACK_TABLES.intersection(out):
+            out[k] = out[k] * fade.reshape(fade.shape + (1,) * (out[k].ndim - fade.ndim))
         return out
 
 

@@ -111,6 +111,19 @@ def schedule_speeds(wind_range: tuple[float, float]) -> np.ndarray:
     return start + SCHEDULE_STEP * np.arange(n)
 
 
+def low_wind_fade(U, lowest: float) -> np.ndarray:
+    """Factor on a schedule's feedback gains at wind speed U below its lowest design speed
+    ``lowest``: (U / lowest)^2, 1 from ``lowest`` up, 0 at zero wind (the braked winch).
+
+    Reeling moves the aerostat across the wind through the blow-by angle, whose tangent (drag
+    over net lift) grows as U^2 at low wind, so the winch's authority over the pendulum fades
+    as U^2 below the schedule while the gains stay those designed at ``lowest``. Unfaded, they
+    saturate the reel through a 10 m swing and the pendulum grows: the modal controller at 1
+    m/s on 2 m/s gains, zeta -0.031 against the braked winch's 0.034; faded, 0.041 (README,
+    "Below the design range")."""
+    return np.clip(np.asarray(U, float) / lowest, 0.0, 1.0) ** 2
+
+
 def held_trims(params: Params, speeds) -> list:
     """(U, trim) at each design speed (non-negative, strictly increasing) whose trim the winch
     motor holds: winch tension at most ``winch.max_motor_force``. Above that speed a feedback
@@ -514,8 +527,9 @@ class LQRSchedule:
 
     def gain(self, U) -> np.ndarray:
         """K at wind speed U (scalar: (6n+9,); array (N,): (N, 6n+9)); linear in U, clamped to
-        the table's end speeds."""
-        return self._interp(self.gains, U)
+        the table's end speeds, and faded below its lowest speed (:func:`low_wind_fade`)."""
+        fade = low_wind_fade(U, self.speeds[0])
+        return self._interp(self.gains, U) * fade[..., None]
 
     # --- persistence ------------------------------------------------------------------------
 
