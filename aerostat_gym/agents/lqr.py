@@ -116,11 +116,11 @@ def low_wind_fade(U, lowest: float) -> np.ndarray:
     ``lowest``: (U / lowest)^2, 1 from ``lowest`` up, 0 at zero wind (the braked winch).
 
     Reeling moves the aerostat across the wind through the blow-by angle, whose tangent (drag
-    over net lift) grows as U^2 at low wind, so the winch's authority over the pendulum fades
-    as U^2 below the schedule while the gains stay those designed at ``lowest``. Unfaded, they
-    saturate the reel through a 10 m swing and the pendulum grows: the modal controller at 1
-    m/s on 2 m/s gains, zeta -0.031 against the braked winch's 0.034; faded, 0.041 (README,
-    "Below the design range")."""
+    over net lift) grows as U^2 at low wind: the winch's authority over the pendulum at the
+    trim vanishes as U -> 0, and gains designed at ``lowest`` ask for reeling it cannot turn
+    into damping. Unfaded, they saturated the reel through a 10 m swing and the pendulum grew:
+    the modal controller at 1 m/s on its 2 m/s gains, zeta -0.031 against the braked winch's
+    0.034; faded with the authority, 0.041 (README, "Below the design range")."""
     return np.clip(np.asarray(U, float) / lowest, 0.0, 1.0) ** 2
 
 
