@@ -17,7 +17,8 @@ from aerostat_gym.agents.authority import (
     reachable,
     target_verdict,
 )
-from aerostat_gym.agents.evaluate import evaluate_policy
+from aerostat_gym.agents.evaluate import cells_result, evaluate_policy
+from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.params import load_params
 
 PROTOCOL = Path(__file__).resolve().parents[1] / "agents" / "baseline_report" / "protocol.json"
@@ -43,6 +44,32 @@ def _stored(cell_scenario: str, speed: float, label: str, metric: str) -> float:
     return cell["policies"][label][metric]["mean"]
 
 
+def test_sweep_rows_are_the_evaluators_episodes_smoke():
+    """Fast version of the next test: the sweep over two report seeds at 8 m/s, light
+    turbulence, against the evaluator's run of the same cells (the default modal design is the
+    ``modal`` baseline): the row's mean RMS displacement and its ratio to the braked winch's
+    equal the evaluator's (rel 1e-12), and the recover row's damping is the evaluator's."""
+    params, seeds = load_params(), (100, 101)
+    sweep = authority_sweep(params, designs=(Design("modal", "modal"),), gusty_speeds=(8.0,),
+                            seeds=seeds, recover_speeds=(10.0,), scenarios=("gusty_light",),
+                            report_speeds=(8.0,))
+    (row,) = sweep["gusty"]
+    (rec,) = sweep["recover"]
+    cells = {"gusty_light": ([8.0], list(seeds)), "recover": ([10.0], list(seeds[:1]))}
+
+    def episodes(name):
+        result = cells_result(load_policy(name, params=params), name, cells, 0.01, params)
+        return {sc: d["episodes"] for sc, d in result["scenarios"].items()}
+
+    modal, passive = episodes("modal"), episodes("passive")
+    mean = np.mean([e["rms_x_m"] for e in modal["gusty_light"]])
+    assert row["rms_x_m"] == pytest.approx(mean, rel=1e-12)
+    assert row["rms_x_ratio"] == pytest.approx(
+        mean / np.mean([e["rms_x_m"] for e in passive["gusty_light"]]), rel=1e-12)
+    assert rec["pendulum_zeta"] == pytest.approx(modal["recover"][0]["pendulum_zeta"], rel=1e-12)
+
+
+@pytest.mark.slow
 def test_sweep_reproduces_the_report_suite():
     """The default modal design in light turbulence at 8 m/s over the 20 report seeds: mean RMS
     along-wind displacement and its ratio to the braked winch's equal the stored protocol's
