@@ -77,17 +77,7 @@ def reference_periods(params: Params | None = None, length: float | None = None)
     tau_axial = 2 pi sqrt(m_e,z L / EA), tau_k = 2 L / (k sqrt((B - m g) / (rho_t A))),
     with m_e = m + k rho V per axis and L the unstretched tether length.
     """
-    p = params or load_params()
-    d = p.derived
-    L = p.tether.length if length is None else length
-    mex, mey, mez = d.effective_mass
-    return {
-        "long_pendulum": period(pendulum_frequency(d.net_lift, mex, L)),
-        "lat_pendulum": period(pendulum_frequency(d.net_lift, mey, L)),
-        "axial_spring": period(axial_spring_frequency(d.EA, mez, L)),
-        "tether_1st": period(tether_harmonic_frequency(1, L, d.net_lift, d.mass_per_length)),
-        "tether_2nd": period(tether_harmonic_frequency(2, L, d.net_lift, d.mass_per_length)),
-    }
+    return _closed_form_periods(params, length, with_tether_mass=False)
 
 
 def tether_mass_periods(params: Params | None = None, length: float | None = None) -> dict:
@@ -109,19 +99,28 @@ def tether_mass_periods(params: Params | None = None, length: float | None = Non
       Rayleigh quotient then holds the mean tension T_top - mu g L / 2 exactly:
       omega_n = (n pi / L) sqrt((T_top - mu g L / 2) / mu).
     """
+    return _closed_form_periods(params, length, with_tether_mass=True)
+
+
+def _closed_form_periods(params: Params | None, length: float | None,
+                         with_tether_mass: bool) -> dict:
+    """The Table 2 closed forms on the string's tension and the masses it carries: the net
+    lift and the aerostat's effective masses, or (``with_tether_mass``) the tether's mean
+    tension and a third of its mass added to each."""
     p = params or load_params()
     d = p.derived
     L = p.tether.length if length is None else length
     mu = d.mass_per_length
-    mean_tension = d.net_lift - 0.5 * mu * p.environment.g * L
-    tether_inertia = mu * L / 3.0
+    tension, tether_inertia = d.net_lift, 0.0
+    if with_tether_mass:
+        tension, tether_inertia = d.net_lift - 0.5 * mu * p.environment.g * L, mu * L / 3.0
     mex, mey, mez = d.effective_mass
     return {
-        "long_pendulum": period(pendulum_frequency(mean_tension, mex + tether_inertia, L)),
-        "lat_pendulum": period(pendulum_frequency(mean_tension, mey + tether_inertia, L)),
+        "long_pendulum": period(pendulum_frequency(tension, mex + tether_inertia, L)),
+        "lat_pendulum": period(pendulum_frequency(tension, mey + tether_inertia, L)),
         "axial_spring": period(axial_spring_frequency(d.EA, mez + tether_inertia, L)),
-        "tether_1st": period(tether_harmonic_frequency(1, L, mean_tension, mu)),
-        "tether_2nd": period(tether_harmonic_frequency(2, L, mean_tension, mu)),
+        "tether_1st": period(tether_harmonic_frequency(1, L, tension, mu)),
+        "tether_2nd": period(tether_harmonic_frequency(2, L, tension, mu)),
     }
 
 
