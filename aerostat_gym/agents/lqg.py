@@ -57,7 +57,7 @@ from .lqr import (
     design_lqr,
     discretize,
     held_trims,
-    low_wind_fade,
+    scheduled_tables,
 )
 from .modal import design_modal
 
@@ -324,25 +324,10 @@ class LQGSchedule:
 
     def lookup(self, U: np.ndarray, names=None) -> dict:
         """The tables ``names`` (default every one) at the speeds U (N,), linear in U between
-        the design speeds; the feedback gains (K, K_integral) faded below the lowest one
-        (:func:`~aerostat_gym.agents.lqr.low_wind_fade`), the filter's tables not."""
-        s = self.speeds
-        U = np.asarray(U, float)
+        the design speeds; the feedback gains (K, K_integral) faded below the lowest one, the
+        filter's tables not (:func:`~aerostat_gym.agents.lqr.scheduled_tables`)."""
         tables = {k: self.tables[k] for k in (names or self.tables)}
-        if s.size == 1:
-            out = {k: np.broadcast_to(v[0], U.shape + v.shape[1:]) for k, v in tables.items()}
-        else:
-            Uc = np.clip(U, s[0], s[-1])
-            i = np.clip(np.searchsorted(s, Uc, side="right") - 1, 0, s.size - 2)
-            w = (Uc - s[i]) / (s[i + 1] - s[i])
-            out = {}
-            for k, v in tables.items():
-                ww = w.reshape(w.shape + (1,) * (v.ndim - 1))
-                out[k] = (1.0 - ww) * v[i] + ww * v[i + 1]
-        fade = low_wind_fade(U, s[0])
-        for k in FEEDBACK_TABLES.intersection(out):
-            out[k] = out[k] * fade.reshape(fade.shape + (1,) * (out[k].ndim - fade.ndim))
-        return out
+        return scheduled_tables(self.speeds, tables, U, FEEDBACK_TABLES)
 
 
 class LQGPolicy:

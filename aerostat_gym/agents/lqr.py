@@ -124,6 +124,27 @@ def low_wind_fade(U, lowest: float) -> np.ndarray:
     return np.clip(np.asarray(U, float) / lowest, 0.0, 1.0) ** 2
 
 
+def scheduled_tables(speeds: np.ndarray, tables: dict, U, faded=frozenset()) -> dict:
+    """Each table of ``tables`` (one row per design speed in ``speeds``) at the wind speeds U
+    (scalar or (N,)): linear in U between the design speeds, clamped to the end speeds; the
+    tables named in ``faded`` (feedback gains) times :func:`low_wind_fade` below the lowest."""
+    U = np.asarray(U, float)
+    if speeds.size == 1:
+        out = {k: np.broadcast_to(v[0], U.shape + v.shape[1:]) for k, v in tables.items()}
+    else:
+        Uc = np.clip(U, speeds[0], speeds[-1])
+        i = np.clip(np.searchsorted(speeds, Uc, side="right") - 1, 0, speeds.size - 2)
+        w = (Uc - speeds[i]) / (speeds[i + 1] - speeds[i])
+        out = {}
+        for k, v in tables.items():
+            ww = w.reshape(w.shape + (1,) * (v.ndim - 1))
+            out[k] = (1.0 - ww) * v[i] + ww * v[i + 1]
+    fade = low_wind_fade(U, speeds[0])
+    for k in set(faded).intersection(out):
+        out[k] = out[k] * fade.reshape(fade.shape + (1,) * (out[k].ndim - fade.ndim))
+    return out
+
+
 def held_trims(params: Params, speeds) -> list:
     """(U, trim) at each design speed (non-negative, strictly increasing) whose trim the winch
     motor holds: winch tension at most ``winch.max_motor_force``. Above that speed a feedback
@@ -513,23 +534,13 @@ class LQRSchedule:
 
     # --- lookup -----------------------------------------------------------------------------
 
-    def _interp(self, table: np.ndarray, U) -> np.ndarray:
+    def gain(self, U) -> np.ndarray:
+        """K at wind speed U (scalar: (6n+9,); array (N,): (N, 6n+9)); linear in U, clamped to
+        the table's end speeds, and faded below its lowest speed (:func:`scheduled_tables`)."""
         U = np.asarray(U, float)
         if not np.all(np.isfinite(U)):
             raise ValueError(f"wind speed must be finite, got {U!r}")
-        s = self.speeds
-        if s.size == 1:
-            return np.broadcast_to(table[0], U.shape + table.shape[1:]).copy()
-        Uc = np.clip(U, s[0], s[-1])
-        i = np.clip(np.searchsorted(s, Uc, side="right") - 1, 0, s.size - 2)
-        w = ((Uc - s[i]) / (s[i + 1] - s[i]))[..., None]
-        return (1.0 - w) * table[i] + w * table[i + 1]
-
-    def gain(self, U) -> np.ndarray:
-        """K at wind speed U (scalar: (6n+9,); array (N,): (N, 6n+9)); linear in U, clamped to
-        the table's end speeds, and faded below its lowest speed (:func:`low_wind_fade`)."""
-        fade = low_wind_fade(U, self.speeds[0])
-        return self._interp(self.gains, U) * fade[..., None]
+        return scheduled_tables(self.speeds, {"K": self.gains}, U, {"K"})["K"]
 
     # --- persistence ------------------------------------------------------------------------
 
