@@ -378,11 +378,17 @@ SEMI_IMPLICIT_REFERENCE_HULL_LENGTH = 18.3
 SEMI_IMPLICIT_REFERENCE_DT = 0.05
 
 
+def froude_step(step: float, length_ratio: float) -> float:
+    """A semi-implicit step carried to an aerostat ``length_ratio`` times as long: shortened
+    by sqrt(length_ratio) for a smaller one (Froude time scaling), never lengthened."""
+    return step * min(1.0, math.sqrt(length_ratio))
+
+
 def advised_semi_implicit_dt(p: Params) -> float:
     """The longest semi-implicit step advised for this aerostat [s]: the baseline's 50 ms
     scaled by sqrt(hull length / 18.3 m) for a shorter hull, 50 ms for a longer one."""
-    ratio = p.aerostat.length / SEMI_IMPLICIT_REFERENCE_HULL_LENGTH
-    return SEMI_IMPLICIT_REFERENCE_DT * min(1.0, math.sqrt(ratio))
+    return froude_step(SEMI_IMPLICIT_REFERENCE_DT,
+                       p.aerostat.length / SEMI_IMPLICIT_REFERENCE_HULL_LENGTH)
 
 
 def _advise(p: Params, source: str) -> None:
