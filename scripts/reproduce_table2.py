@@ -1,5 +1,6 @@
-"""Reproduce [LN02] Table 2 (theory at U = 0 vs the linear model at U = 1 m/s) and the
-sensitivity of its periods to the estimated parameters.
+"""Reproduce [LN02] Table 2 (theory at U = 0 vs the linear model at U = 1 m/s; for any
+aerostat, its linear model in still air vs its still-air closed form) and the sensitivity of
+its periods to the estimated parameters.
 
 Usage: python scripts/reproduce_table2.py --out DIR [--config FILE] [--no-sensitivity]
 Writes DIR/table2.json, table2.csv, table2.txt and (unless --no-sensitivity)
