@@ -141,6 +141,19 @@ def test_invalid_arguments_name_the_problem():
             TetheredAerostatEnv(obs_noise=noise)
 
 
+def test_a_single_wind_speed_fixes_the_wind():
+    """wind_speed=10.0 is the range (10, 10): every episode's mean wind is 10 m/s (exact), as
+    with the pair; a negative number or a bool is refused by name, quoting the value given."""
+    env = TetheredAerostatEnv(wind_speed=10.0)
+    assert env.task.resolved["wind_speed"] == (10.0, 10.0)
+    for seed in range(3):
+        assert env.reset(seed=seed)[1]["wind_speed"] == 10.0
+    with pytest.raises(TaskError, match=r"wind_speed must satisfy .* got -1.0$"):
+        TetheredAerostatEnv(wind_speed=-1.0)
+    with pytest.raises(TaskError, match="wind_speed must be a number or a"):
+        TetheredAerostatEnv(wind_speed=True)
+
+
 def test_reset_starts_at_exact_trim_without_perturbation():
     """perturbation='none', no turbulence: the start is an equilibrium, so after 10 s with the
     brake on the aerostat has moved < 1e-3 m (trim residual 1e-9 relative)."""

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import numbers
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
@@ -48,10 +49,12 @@ class TaskError(ValueError):
 
 
 def _range(name, value, lo_min=0.0):
+    """A (low, high) range; a single number is the fixed value (value, value)."""
+    pair = (value, value) if isinstance(value, numbers.Real) and not isinstance(value, bool) else value
     try:
-        lo, hi = (float(v) for v in value)
+        lo, hi = (float(v) for v in pair)
     except (TypeError, ValueError):
-        raise TaskError(f"{name} must be a (low, high) pair, got {value!r}") from None
+        raise TaskError(f"{name} must be a number or a (low, high) pair, got {value!r}") from None
     if not (math.isfinite(lo) and math.isfinite(hi) and lo_min <= lo <= hi):
         raise TaskError(f"{name} must satisfy {lo_min} <= low <= high (finite), got {value!r}")
     return lo, hi

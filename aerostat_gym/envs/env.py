@@ -134,7 +134,8 @@ class TetheredAerostatEnv(gym.Env):
 
     ``gym.make("TetheredAerostat-v0", **kwargs)`` with:
 
-    - ``wind_speed=(3.0, 15.0)``: range of the episode's mean wind speed [m/s].
+    - ``wind_speed=(3.0, 15.0)``: range of the episode's mean wind speed [m/s]; a single number
+      fixes it (``wind_speed=10.0`` is ``(10.0, 10.0)``; the same holds for the gust ranges).
     - ``turbulence="moderate"``: intensity class ("none", "light", "moderate", "severe":
       sigma follows each episode's mean wind, :mod:`aerostat_gym.wind.presets`), "config" (the
       parameter file's ``wind.turbulence`` and ``wind.turbulence_model``), or a dict of
