@@ -154,6 +154,20 @@ def test_a_single_wind_speed_fixes_the_wind():
         TetheredAerostatEnv(wind_speed=True)
 
 
+def test_bad_reset_options_name_the_problem():
+    """reset(options=...): a misspelt key names the known ones; a wind speed that is not a
+    number, NaN, or outside the task's range is a TaskError that quotes it."""
+    env = TetheredAerostatEnv()
+    with pytest.raises(TaskError, match=r"unknown reset option\(s\) \['windspeed'\]"):
+        env.reset(seed=0, options={"windspeed": 5.0})
+    with pytest.raises(TaskError, match="wind_speed must be a number .* got 'fast'"):
+        env.reset(seed=0, options={"wind_speed": "fast"})
+    for bad in (float("nan"), 50.0, 2.9):
+        with pytest.raises(TaskError, match=r"outside the task's range \[3.0, 15.0\]"):
+            env.reset(seed=0, options={"wind_speed": bad})
+    assert env.reset(seed=0, options={"wind_speed": 14.96})[1]["wind_speed"] == 15.0
+
+
 def test_reset_starts_at_exact_trim_without_perturbation():
     """perturbation='none', no turbulence: the start is an equilibrium, so after 10 s with the
     brake on the aerostat has moved < 1e-3 m (trim residual 1e-9 relative)."""

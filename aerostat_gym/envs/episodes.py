@@ -181,8 +181,12 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
 def _speed_index(trims: TrimTable, fixed, rng) -> int:
     if fixed is None:
         return int(rng.integers(len(trims.speeds)))
-    k = int(np.argmin(np.abs(trims.speeds - float(fixed))))
-    if abs(trims.speeds[k] - float(fixed)) > WIND_GRID / 2 + 1e-9:
+    try:
+        speed = float(fixed)
+    except (TypeError, ValueError):
+        raise TaskError(f"reset option wind_speed must be a number [m/s], got {fixed!r}") from None
+    k = int(np.argmin(np.abs(trims.speeds - speed)))
+    if not abs(trims.speeds[k] - speed) <= WIND_GRID / 2 + 1e-9:  # NaN fails too
         raise TaskError(f"reset option wind_speed={fixed!r} is outside the task's range "
                         f"[{trims.speeds[0]}, {trims.speeds[-1]}] m/s")
     return k
