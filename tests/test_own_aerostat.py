@@ -42,7 +42,12 @@ from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.analysis.figures import family_values, figure8_data
 from aerostat_gym.analysis.linear import ACTUATORS, U_FREE, input_jacobian
 from aerostat_gym.analysis.modes import analyse, wind_sweep
-from aerostat_gym.analysis.reference import THEORY_TOLERANCE_PCT, table2, veering_allowance
+from aerostat_gym.analysis.reference import (
+    THEORY_TOLERANCE_PCT,
+    format_table2,
+    table2,
+    veering_allowance,
+)
 from aerostat_gym.analysis.sensitivity import default_knobs
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.bench.soak import VARIANTS, soak_configuration
@@ -209,6 +214,18 @@ def test_axial_spring_veers_where_the_tether_harmonic_comes_near():
     assert row["within_tolerance"], row
     assert row["calm_diff_pct"] == pytest.approx(-4.38, abs=0.1), row
     assert row["calm_linear_s"] < row["closed_form_s"] < row["veering_partner_s"], row
+
+
+def test_table2_on_a_one_element_tether():
+    """One element has no moving tether node: the modes still classify (a shape with no node
+    has no sign change), the aerostat's rows pass (pendulum -0.15 % of the closed form), and the
+    tether harmonic, which the model cannot carry, is a MISS that reads 'not found'."""
+    p = load_params(overrides={"tether.n_elements": 1})
+    rows = {r["key"]: r for r in table2(p)}
+    assert rows["long_pendulum"]["calm_diff_pct"] == pytest.approx(-0.15, abs=0.05)
+    assert all(rows[k]["within_tolerance"] for k in ("long_pendulum", "lat_pendulum", "axial_spring"))
+    assert math.isnan(rows["tether_1st"]["calm_linear_s"]) and not rows["tether_1st"]["within_tolerance"]
+    assert "not found" in format_table2(list(rows.values()))
 
 
 def test_params_provenance(case, capsys):

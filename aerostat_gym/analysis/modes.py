@@ -174,6 +174,8 @@ def _realify(v: np.ndarray) -> np.ndarray:
 
 def count_sign_changes(shape: np.ndarray, threshold: float = 0.1) -> int:
     """Sign changes along ``shape``, ignoring entries below ``threshold`` of its largest |entry|."""
+    if shape.size == 0:  # a one-element tether has no moving node
+        return 0
     big = shape[np.abs(shape) > threshold * np.max(np.abs(shape))]
     return int(np.sum(np.signbit(big[1:]) != np.signbit(big[:-1])))
 
