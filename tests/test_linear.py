@@ -39,7 +39,7 @@ from aerostat_gym.analysis.reference import (
     tether_mass_periods,
 )
 from aerostat_gym.analysis.sensitivity import default_knobs, solve_for_period, stability_figures
-from aerostat_gym.analysis.trim import find_equilibrium
+from aerostat_gym.analysis.trim import TrimLimitError, find_equilibrium
 from aerostat_gym.bench.linear import bench_sweep
 from aerostat_gym.cli.stability import add_stability_parsers, parse_speeds
 from aerostat_gym.params import load_params
@@ -401,6 +401,19 @@ def test_cli_stability_and_table2(capsys, tmp_path):
     assert _cli(["table2", "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)
     assert [r["key"] for r in rows] == list(TABLE2)
+
+
+def test_stability_sweep_stops_where_the_tether_breaks(capsys):
+    """The baseline's tether (35.6 kN) holds the 50 m/s trim and not the 60 m/s one (39.8 kN):
+    ``--wind 40:60:10`` sweeps 40 and 50 m/s and warns where and why it stopped; a sweep of
+    speeds none of which it holds is refused with the tension and the strength."""
+    assert _cli(["stability", "--wind", "40:60:10", "--json"]) == 0
+    captured = capsys.readouterr()
+    assert sorted({row["wind_speed_m_s"] for row in json.loads(captured.out)["modes"]}) == [40.0, 50.0]
+    assert "the sweep stops at 50 m/s: at U = 60 m/s the trim tension" in captured.err
+    assert "tether.strength = 35600 N" in captured.err
+    with pytest.raises(TrimLimitError, match="at U = 60 m/s .* exceeds tether.strength"):
+        _cli(["stability", "--wind", "60:70:10"])
 
 
 def test_bench_sweep_reports():

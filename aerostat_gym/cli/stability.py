@@ -33,7 +33,7 @@ from ..analysis.sensitivity import (
     select_knobs,
     sensitivity_table,
 )
-from ..analysis.trim import find_equilibrium, limit_warnings
+from ..analysis.trim import TrimLimitError, find_equilibrium, limit_warnings
 from .common import add_config, params_from_args, positive_float, positive_int, warn
 
 
@@ -95,13 +95,30 @@ def _stability_text(sweep, dec_ratios: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def held_speeds(params, speeds: np.ndarray) -> np.ndarray:
+    """The sweep's speeds whose trim the tether holds, with a warning for what the winch and
+    tether cannot do at the top one and for the speeds left out. The tension grows with the
+    wind, so the sweep stops below the first speed past the tether's strength; none held is the
+    lowest speed's :class:`TrimLimitError`."""
+    speeds = np.sort(np.asarray(speeds, float))
+    broken = None
+    for k in range(len(speeds) - 1, -1, -1):
+        try:
+            messages = limit_warnings(params, find_equilibrium(params, float(speeds[k])).summary)
+        except TrimLimitError as exc:
+            broken = exc
+            continue
+        for message in messages:
+            warn("stability", message)
+        if broken is not None:
+            warn("stability", f"the sweep stops at {speeds[k]:g} m/s: {broken}")
+        return speeds[: k + 1]
+    raise broken
+
+
 def cmd_stability(args) -> int:
     params = stability_params(args)
-    speeds = parse_speeds(args.wind)
-    # the tension grows with the wind: the top speed's trim tells what the winch and tether
-    # cannot hold (TrimLimitError past the tether strength)
-    for message in limit_warnings(params, find_equilibrium(params, float(speeds.max())).summary):
-        warn("stability", message)
+    speeds = held_speeds(params, parse_speeds(args.wind))
     sweep = wind_sweep(params, speeds)
     ratios = [a.decoupled.ratios for a in sweep.analyses]
     if args.plot:
