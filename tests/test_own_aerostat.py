@@ -28,7 +28,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from aerostat_gym.agents.evaluate import evaluate_policy
+from aerostat_gym.agents.evaluate import default_wind_range, evaluate_policy
 from aerostat_gym.agents.lqr import (
     LQR_MAX_DEVIATIONS,
     LQRPolicy,
@@ -52,6 +52,7 @@ from aerostat_gym.analysis.sensitivity import default_knobs
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main
+from aerostat_gym.envs.episodes import TrimTable
 from aerostat_gym.params import (
     SEMI_IMPLICIT_REFERENCE_DT,
     SEMI_IMPLICIT_REFERENCE_HULL_LENGTH,
@@ -226,6 +227,27 @@ def test_table2_on_a_one_element_tether():
     assert all(rows[k]["within_tolerance"] for k in ("long_pendulum", "lat_pendulum", "axial_spring"))
     assert math.isnan(rows["tether_1st"]["calm_linear_s"]) and not rows["tether_1st"]["within_tolerance"]
     assert "not found" in format_table2(list(rows.values()))
+
+
+def test_evaluate_on_a_tether_that_cannot_hold_the_default_winds(capsys, tmp_path):
+    """A tether rated 3.3 kN holds the baseline's trims up to 12.3 m/s (3.23 kN at 12 m/s,
+    3.79 kN at 15 m/s): the default wind range's top comes down to the highest 0.1 m/s grid
+    speed it holds, ``evaluate`` on a suite that flies at 15 m/s is refused with the way out
+    named, and ``--speeds 5 8`` runs on the winds the aerostat holds."""
+    weak = ["--set", "tether.strength=3300", "--set", "winch.safe_working_load=3000"]
+    p = load_params(overrides={"tether.strength": 3300.0, "winch.safe_working_load": 3000.0})
+    lo, top = default_wind_range(p)
+    trims = TrimTable(p, 3.0, 15.0)
+    k = int(np.argmin(np.abs(trims.speeds - top)))
+    assert lo == 3.0 and 12.0 < top < 12.5
+    assert trims.tensions[k] < 3300.0 <= trims.tensions[k + 1]
+    assert default_wind_range(load_params()) == (3.0, 15.0)
+    assert main(["evaluate", "--policy", "passive", "--no-plots", "--out", str(tmp_path), *weak]) == 2
+    assert "run its scenarios at wind speeds this aerostat holds with --speeds" in capsys.readouterr().err
+    out = _run(capsys, ["evaluate", "--policy", "passive", "--speeds", "5", "8", "--no-plots",
+                        "--out", str(tmp_path), "--json", *weak])
+    rows = json.loads(out)[0]["scenarios"]["recover"]["episodes"]
+    assert sorted(r["wind_speed"] for r in rows) == [5.0, 8.0]
 
 
 def test_params_provenance(case, capsys):

@@ -42,10 +42,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..envs.batch import held_wind_top
 from ..envs.config import DEFAULT_WIND_RANGE
 from ..envs.spaces import N_OBS
 from ..envs.vector import TetheredAerostatVectorEnv
-from ..params import dumps_toml, load_params
+from ..params import Params, dumps_toml, load_params
 from .metrics import response_metrics
 from .policies import load_policy
 from .sb3io import PolicyError
@@ -164,12 +165,26 @@ def suite_cells(name: str, speeds=None) -> dict:
     return {sc: (us, seeds) for sc, (_, seeds) in cells.items()}
 
 
-def cells_wind_range(cells: dict) -> tuple[float, float]:
+def cells_wind_range(cells: dict, params=None) -> tuple[float, float]:
     """The training range DEFAULT_WIND_RANGE widened to every speed of ``cells``: the range the
-    environments run in and the baselines are scheduled over."""
+    environments run in and the baselines are scheduled over. With ``params``, the training
+    range's top comes down to the highest wind whose trim the configured tether holds
+    (:func:`default_wind_range`), so an aerostat that cannot fly at 15 m/s runs cells at the
+    winds it can."""
     us = [u for speeds, _ in cells.values() for u in speeds]
-    lo, hi = DEFAULT_WIND_RANGE
+    lo, hi = DEFAULT_WIND_RANGE if params is None else default_wind_range(params)
     return min(lo, min(us)), max(hi, max(us))
+
+
+def default_wind_range(params=None) -> tuple[float, float]:
+    """DEFAULT_WIND_RANGE, its top lowered to the highest wind whose trim the tether of
+    ``params`` (a Params, a file or a shipped name; None: the baseline, which holds it all)
+    holds (:func:`~aerostat_gym.envs.batch.held_wind_top`)."""
+    lo, hi = DEFAULT_WIND_RANGE
+    if params is None:
+        return lo, hi
+    params = params if isinstance(params, Params) else load_params(params)
+    return lo, held_wind_top(params, lo, hi)
 
 
 def describe_suite(name: str, speeds=None) -> str:
@@ -227,7 +242,8 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     sc = SCENARIOS[scenario]
     pairs = [(u, s) for u in speeds for s in seeds]
     steps = int(round(sc.duration / control_step))
-    kwargs = {"wind_speed": cells_wind_range({scenario: (speeds, seeds)}),
+    kwargs = {"wind_speed": cells_wind_range({scenario: (speeds, seeds)},
+                                             (env_kwargs or {}).get("params")),
               **(env_kwargs or {}), **sc.env_kwargs}
     env = TetheredAerostatVectorEnv(num_envs=len(pairs), max_episode_steps=steps,
                                     observation="full", control_step=control_step, **kwargs)
@@ -347,8 +363,8 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
     noise = SUITE_OBS_NOISE.get(suite, 0.0)
     params = params if params is not None and not isinstance(params, str) else load_params(params)
     policy = load_policy(policy_name, params=params, dt=control_step, obs_noise=noise,
-                         wind_range=DEFAULT_WIND_RANGE if speeds is None
-                         else cells_wind_range(cells))
+                         wind_range=default_wind_range(params) if speeds is None
+                         else cells_wind_range(cells, params))
     out = {"policy": policy_name, "suite": suite, "scenarios": {}, "obs_noise": noise,
            "speeds": None if speeds is None else cells[next(iter(cells))][0],
            "tether_length_m": params.tether.length, "params_toml": dumps_toml(params)}

@@ -86,16 +86,23 @@ def _check_policies(names) -> None:
             raise ValueError(f"--policy {name}: {exc}") from None
 
 
+def _check_suite_winds(suite: str, speeds, params) -> None:
+    """Refuse, before any episode, a suite whose wind speeds (its own or ``--speeds``) include
+    one whose trim the configured tether cannot hold, naming the way out."""
+    try:
+        winds = cells_wind_range(suite_cells(suite, speeds), params)
+        trim_table(TaskConfig.from_kwargs(wind_speed=winds, params=params))
+    except ValueError as exc:
+        if speeds is not None:
+            raise ValueError(f"--speeds: {exc}") from None
+        raise ValueError(f"--suite {suite}: {exc}; run its scenarios at wind speeds this "
+                         "aerostat holds with --speeds U [U ...]") from None
+
+
 def _evaluate_command(args) -> int:
     _check_policies(args.policy)
     params = params_from_args(args)
-    if args.speeds is not None:  # a speed whose trim the tether cannot hold: refused up front
-        cells = suite_cells(args.suite, args.speeds)
-        try:
-            trim_table(TaskConfig.from_kwargs(wind_speed=cells_wind_range(cells),
-                                              params=params))
-        except ValueError as exc:
-            raise ValueError(f"--speeds: {exc}") from None
+    _check_suite_winds(args.suite, args.speeds, params)
     results = run_evaluations(args.policy, args.suite, progress=not args.json, params=params,
                               speeds=args.speeds)
     md = write_report(results, args.out, f"Evaluation on suite `{args.suite}`",
@@ -121,6 +128,9 @@ def add_demo_parser(sub) -> None:
                    help="policy to compare with the baselines: shipped or PATH.zip")
     p.add_argument("--out", default="runs/demo", help="report directory")
     p.add_argument("--suite", choices=list(SUITES), default="tiny", help="evaluation suite")
+    p.add_argument("--speeds", type=nonneg_float, nargs="+", metavar="U",
+                   help="run the suite's scenarios at these mean wind speeds [m/s] instead of "
+                   "its own (as evaluate --speeds)")
     add_config(p, json=False)
     p.set_defaults(func=_demo_command)
 
@@ -132,9 +142,10 @@ def _demo_command(args) -> int:
     policies = ["passive", "lqr"]
     if params == load_params() or args.policy != "shipped":
         policies.append(args.policy)  # the shipped policy was trained on the baseline
+    _check_suite_winds(args.suite, args.speeds, params)
     summary = demo_summary(params, args.wind, config_label(args))
     print("\n".join(summary))
-    results = run_evaluations(policies, args.suite, params=params)
+    results = run_evaluations(policies, args.suite, params=params, speeds=args.speeds)
     md = write_report(results, args.out, "aerostat-gym demo",
                       "aerostat-gym demo " + " ".join(sys.argv[1:]),
                       preamble=["## Trim and linear stability", "", "```", *summary, "```", ""])

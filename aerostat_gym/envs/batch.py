@@ -12,6 +12,7 @@ import numba
 import numpy as np
 
 from ..analysis.trim import TrimError
+from ..params import Params
 from ..physics.integrators import scheme
 from ..physics.outputs import winch_tension
 from ..physics.packing import P_SIZE
@@ -297,6 +298,17 @@ class EnvBatch:
                 "tension": model.end_tensions(x, float(self.time[i]))[1],
                 "length": float(x[lay.winch_length]), "reel_speed": float(x[lay.winch_speed]),
                 "wind_speed": ep.wind_speed, "params": ep.params}
+
+
+def held_wind_top(params: Params, lo: float, hi: float) -> float:
+    """The highest wind on the 0.1 m/s grid of [lo, hi] whose trim the configured tether holds
+    (winch tension below ``tether.strength``; it grows with the wind), ``hi`` where it holds
+    them all and ``lo`` where it holds none (:func:`trim_table` then names the tension)."""
+    trims = TrimTable(params, lo, hi)
+    held = trims.tensions < params.tether.strength
+    if held.all() or not held[0]:
+        return hi if held.all() else lo
+    return float(trims.speeds[np.argmin(held) - 1])
 
 
 def trim_table(task: TaskConfig) -> TrimTable:
