@@ -296,6 +296,32 @@ def test_6_rk4_past_its_stability_step_is_a_numerical_failure():
     assert info["failure"] == info["termination"]
 
 
+def test_6_rk4_on_few_long_elements_is_capped_at_the_aerostats_step():
+    """Two elements on 884 m under a 0.011x hull: the tether's axial RK4 bound is 0.119 s,
+    but the aerostat's fastest aerodynamic rate reaches 35.5 /s at 25 m/s (|lambda| h = 4.2,
+    past RK4's 2.8); the step is capped at simulation.semi_implicit_dt (0.0236 s, the
+    Froude-scaled step). At the axial bound (the step before the cap) the 1,600 random-reeling
+    steps below at 20-25 m/s end 7 episodes as numerical failures; capped, none."""
+    from aerostat_gym.physics.integrators import rk4_step
+    from aerostat_gym.scaling import scale_aerostat
+
+    p = scale_aerostat(load_params(), 0.011, 884.0, 2, -2.6)
+    d, sim = p.derived, p.simulation
+    axial = rk4_step(d.EA, d.mass_per_length, 442.0, sim.rk4_safety, 2)
+    assert axial == pytest.approx(0.119, abs=0.001) and sim.semi_implicit_dt < 0.2 * axial
+    assert Model(p, 20.0).rk4_dt() == sim.semi_implicit_dt
+    env = _quiet(TetheredAerostatVectorEnv, 8, params=p, integrator="rk4", wind_speed=(20.0, 25.0),
+                 turbulence="moderate", randomize=True)
+    env.reset(seed=5)
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        obs, _, terminated, _, info = env.step(rng.uniform(-1.5, 1.5, (8, 1)).astype(np.float32))
+        assert np.all(np.isfinite(obs))
+        ends = info.get("termination", np.array([None] * 8))
+        assert not any(e in ("numerical_divergence", "nonfinite_state") for e in ends[terminated])
+    env.close()
+
+
 def _kicked_baseline_step():
     """A pitch-rate kick of 3 rad/s on the trim at 10 m/s, 8 control steps later: a step whose
     peak tension the 50 ms semi-implicit step overshoots (a few per cent above the finer

@@ -115,10 +115,13 @@ class Model:
 
 
     def rk4_dt(self, length: float | None = None) -> float:
-        """RK4 step from the axial stability bound at the given (default: configured) length."""
-        d = self.params.derived
+        """RK4 step at the given (default: configured) length: the tether's axial stability
+        bound, capped at the aerostat's explicit step ``simulation.semi_implicit_dt`` (as the
+        compiled interval advance takes it)."""
+        d, sim = self.params.derived, self.params.simulation
         L = self.params.tether.length if length is None else length
-        return rk4_step(d.EA, d.mass_per_length, L / self.n, self.params.simulation.rk4_safety, self.n)
+        return min(rk4_step(d.EA, d.mass_per_length, L / self.n, sim.rk4_safety, self.n),
+                   sim.semi_implicit_dt)
 
     # --- time stepping ---------------------------------------------------------------------
 
