@@ -28,7 +28,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from aerostat_gym.agents.evaluate import default_wind_range, evaluate_policy
+from aerostat_gym.agents.evaluate import default_wind_range, evaluate_policy, held_suite_speeds
 from aerostat_gym.agents.lqr import (
     LQR_MAX_DEVIATIONS,
     LQRPolicy,
@@ -39,6 +39,7 @@ from aerostat_gym.agents.lqr import (
 )
 from aerostat_gym.agents.metrics import fit_damped_sinusoid
 from aerostat_gym.agents.policies import load_policy
+from aerostat_gym.agents.train import held_training_winds
 from aerostat_gym.analysis.figures import family_values, figure8_data
 from aerostat_gym.analysis.linear import ACTUATORS, U_FREE, input_jacobian
 from aerostat_gym.analysis.modes import analyse, wind_sweep
@@ -248,6 +249,22 @@ def test_evaluate_on_a_tether_that_cannot_hold_the_default_winds(capsys, tmp_pat
                         "--out", str(tmp_path), "--json", *weak])
     rows = json.loads(out)[0]["scenarios"]["recover"]["episodes"]
     assert sorted(r["wind_speed"] for r in rows) == [5.0, 8.0]
+
+
+def test_training_on_a_tether_that_cannot_hold_the_task_winds():
+    """Training on the 3.3 kN tether (holds the trims up to 12.3 m/s): the task's (3, 15) m/s
+    comes down to the highest held wind with a warning that says so, and the evaluation suite
+    runs its scenarios at the suite's speeds the tether holds (tiny: 5 and 10 m/s of 5, 10,
+    15); on the baseline both stay as they are, without a warning."""
+    weak = load_params(overrides={"tether.strength": 3300.0, "winch.safe_working_load": 3000.0})
+    with pytest.warns(UserWarning, match=r"holds the trim only up to 12\.\d m/s; training on"):
+        lo, top = held_training_winds({"params": weak, "wind_speed": (3.0, 15.0)})
+    assert (lo, top) == default_wind_range(weak)
+    assert held_suite_speeds("tiny", weak) == [5.0, 10.0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert held_training_winds({"params": load_params()}) == (3.0, 15.0)
+        assert held_suite_speeds("tiny", load_params()) is None
 
 
 def test_params_provenance(case, capsys):

@@ -187,6 +187,20 @@ def default_wind_range(params=None) -> tuple[float, float]:
     return lo, held_wind_top(params, lo, hi)
 
 
+def held_suite_speeds(name: str, params=None) -> list | None:
+    """Wind speeds to run suite ``name`` at on an aerostat whose tether cannot hold all of its
+    own (its speeds up to the highest held wind, or that wind alone: :func:`suite_cells`'s
+    ``speeds``), or None where it holds them all (the suite runs as it is)."""
+    us = sorted({u for speeds, _ in check_suite(name).values() for u in speeds})
+    if params is None:
+        return None
+    params = params if isinstance(params, Params) else load_params(params)
+    top = held_wind_top(params, min(us), max(us))
+    if top >= max(us):
+        return None
+    return [u for u in us if u <= top] or [top]
+
+
 def describe_suite(name: str, speeds=None) -> str:
     """One line per scenario of a suite (at ``speeds`` if given, see :func:`suite_cells`): wind
     speeds, seeds (as ranges) and description."""
@@ -400,9 +414,11 @@ def cells_result(policy, label: str, cells: dict, obs_noise: float, params=None,
             "scenarios": scenarios}
 
 
-def suite_score(policy, suite: str = "tiny", control_step: float = 0.2, params=None) -> float:
+def suite_score(policy, suite: str = "tiny", control_step: float = 0.2, params=None,
+                speeds=None) -> float:
     """Mean episode return of a policy object on a suite (the training curve's measure), in
-    the environment of ``params`` (default: the baseline) with the suite's sensor noise."""
-    returns = [r for _, ep in suite_episodes(policy, suite, control_step, params)
+    the environment of ``params`` (default: the baseline) with the suite's sensor noise, at
+    ``speeds`` if given (:func:`suite_cells`)."""
+    returns = [r for _, ep in suite_episodes(policy, suite, control_step, params, speeds)
                for r in ep.returns]
     return float(np.mean(returns))

@@ -57,18 +57,21 @@ import platform
 import shlex
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from .. import __version__
+from ..envs.batch import held_wind_top
+from ..envs.config import TaskConfig
 from ..envs.sb3 import sb3_vec_env
 from ..params import Params, dumps_toml, load_params
 from ..registration import TASKS
 from ..resources import shipped_path
 from .asymmetric import actor_channels
 from .asymmetric import policy_class as asymmetric_policy_class
-from .evaluate import check_suite, suite_score
+from .evaluate import check_suite, held_suite_speeds, suite_score
 from .policies import load_policy
 from .report import plot_training_curve
 from .residual import check_residual, residual_shaper, residual_vec_env
@@ -256,6 +259,7 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     env_kwargs = {**TASKS[task_id][0], **(project.get("env_kwargs") or {})}
     if params is not None:
         env_kwargs["params"] = params
+        env_kwargs["wind_speed"] = held_training_winds(env_kwargs)
     run = Path(run_dir or f"runs/train/{algo}_seed{seed}_{time.strftime('%Y%m%d-%H%M%S')}")
     run.mkdir(parents=True, exist_ok=True)
     if threads:
@@ -306,6 +310,21 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     return run
 
 
+def held_training_winds(env_kwargs: dict) -> tuple[float, float]:
+    """The task's wind range (``env_kwargs["wind_speed"]``, default DEFAULT_WIND_RANGE), its top
+    lowered, with a warning, to the highest wind whose trim the tether of
+    ``env_kwargs["params"]`` holds (:func:`~aerostat_gym.envs.batch.held_wind_top`): a small
+    aerostat on a long tether trains on the winds it can fly in."""
+    task = TaskConfig.from_kwargs(**{k: env_kwargs[k] for k in ("wind_speed", "params")
+                                     if k in env_kwargs})
+    lo, hi = task.resolved["wind_speed"]
+    top = held_wind_top(task.params_resolved, lo, hi)
+    if top < hi:
+        warnings.warn(f"wind_speed ({lo:g}, {hi:g}) m/s: this configuration's tether holds the "
+                      f"trim only up to {top:g} m/s; training on ({lo:g}, {top:g})", stacklevel=3)
+    return lo, top
+
+
 def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=None,
                         wrappers: dict | None = None, base=None):
     """A callback that, every ``freq`` calls, scores the current policy on the fixed suite
@@ -316,6 +335,10 @@ def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=N
     from stable_baselines3.common.callbacks import BaseCallback
 
     check_suite(suite)
+    speeds = held_suite_speeds(suite, params)
+    if speeds is not None:
+        warnings.warn(f"eval_suite {suite!r}: this configuration's tether cannot hold every "
+                      f"wind of the suite; its scenarios run at {speeds} m/s", stacklevel=2)
 
     class SuiteEvalCallback(BaseCallback):
         def __init__(self):
@@ -333,7 +356,7 @@ def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=N
 
         def evaluate_now(self) -> None:
             score = suite_score(run_policy(self.model, wrappers or {}, base), suite,
-                                params=params)
+                                params=params, speeds=speeds)
             self.logger.record("eval/suite_score", score)
             self.history.append({"timesteps": int(self.num_timesteps), "score": score,
                                  "wall_time_s": time.perf_counter() - self.t0})
