@@ -139,10 +139,13 @@ def format_summary(s: dict) -> str:
         lines.append(f"smallest damping ratio: median {z['p50']:.4f} [5 %: {z['p5']:.4f}, "
                      f"95 %: {z['p95']:.4f}]; {z['divergences']} sets with a divergence "
                      "(a real positive eigenvalue, zeta = -1)")
-    lines.append("parameters vs instability: r (unstable somewhere), Spearman rho (max Re "
-                 "lambda), unstable rate in the low / high fifth of the range")
+    lines.append("parameters vs instability: r (unstable somewhere; '-' when every set is "
+                 "stable), Spearman rho (max Re lambda), unstable rate in the low / high fifth "
+                 "of the range")
     for r in s["correlations"]:
-        lines.append(f"  {r['parameter']:26s} r {r['r_unstable']:+.3f}  rho {r['rho_max_real']:+.3f}"
+        corr = r["r_unstable"]
+        corr = f"{corr:+.3f}" if math.isfinite(corr) else f"{'-':>6s}"
+        lines.append(f"  {r['parameter']:26s} r {corr}  rho {r['rho_max_real']:+.3f}"
                      f"  {_pct(r['unstable_rate_low_fifth'])} % / {_pct(r['unstable_rate_high_fifth'])} %")
     for m in s["mode_instabilities"]:
         u = m["speeds_m_s"]
