@@ -98,22 +98,32 @@ def _stability_text(sweep, dec_ratios: list[dict]) -> str:
 def held_speeds(params, speeds: np.ndarray) -> np.ndarray:
     """The sweep's speeds whose trim the tether holds, with a warning for what the winch and
     tether cannot do at the top one and for the speeds left out. The tension grows with the
-    wind, so the sweep stops below the first speed past the tether's strength; none held is the
-    lowest speed's :class:`TrimLimitError`."""
+    wind, so the sweep stops below the first speed past the tether's strength (found by
+    bisection); none held is the lowest speed's :class:`TrimLimitError`."""
     speeds = np.sort(np.asarray(speeds, float))
-    broken = None
-    for k in range(len(speeds) - 1, -1, -1):
-        try:
-            messages = limit_warnings(params, find_equilibrium(params, float(speeds[k])).summary)
-        except TrimLimitError as exc:
-            broken = exc
-            continue
-        for message in messages:
-            warn("stability", message)
-        if broken is not None:
-            warn("stability", f"the sweep stops at {speeds[k]:g} m/s: {broken}")
-        return speeds[: k + 1]
-    raise broken
+
+    def warnings_at(k):  # TrimLimitError past the tether's strength
+        return limit_warnings(params, find_equilibrium(params, float(speeds[k])).summary)
+
+    try:
+        messages, top, broken = warnings_at(len(speeds) - 1), len(speeds) - 1, None
+    except TrimLimitError as exc:
+        broken, held, past = exc, -1, len(speeds) - 1  # speeds[past] breaks it
+        while past - held > 1:
+            mid = (held + past) // 2
+            try:
+                warnings_at(mid)
+                held = mid
+            except TrimLimitError as exc_mid:
+                broken, past = exc_mid, mid
+        if held < 0:
+            raise broken from None
+        messages, top = warnings_at(held), held
+    for message in messages:
+        warn("stability", message)
+    if broken is not None:
+        warn("stability", f"the sweep stops at {speeds[top]:g} m/s: {broken}")
+    return speeds[: top + 1]
 
 
 def cmd_stability(args) -> int:
