@@ -222,7 +222,10 @@ def hanging_chain_periods(params: Params | None = None, length: float | None = N
         upper = 2.0 * math.pi / rayleigh[key]
         grid = np.linspace(1e-3 * upper, upper * (1.0 + 1e-9), 400)
         values = [tip_balance(w, tip_mass) for w in grid]
-        k = next(i for i in range(len(grid) - 1) if values[i] * values[i + 1] <= 0.0)
+        k = next((i for i in range(len(grid) - 1) if values[i] * values[i + 1] <= 0.0), None)
+        if k is None:  # no root resolved below the bound: keep the Rayleigh estimate
+            out[key] = rayleigh[key]
+            continue
         out[key] = 2.0 * math.pi / optimize.brentq(tip_balance, grid[k], grid[k + 1],
                                                    args=(tip_mass,), xtol=1e-14, rtol=1e-13)
     return out
