@@ -28,7 +28,9 @@ def main(argv=None) -> int:
     if not args.no_families:
         fams = write_families(args.out, params)
         for name, fam in fams.items():
-            print(f"{name}: " + ", ".join(f"{v:g} stable={d['all_stable']}" for v, d in fam.items()))
+            print(f"{name}: " + ", ".join(
+                f"{v:g} stable={d['all_stable']} to {d['wind_speed_m_s'][-1]:g} m/s"
+                for v, d in fam.items()))
     return 0
 
 

@@ -50,7 +50,7 @@ from aerostat_gym.analysis.reference import (
     veering_allowance,
 )
 from aerostat_gym.analysis.sensitivity import default_knobs
-from aerostat_gym.analysis.trim import find_equilibrium
+from aerostat_gym.analysis.trim import TrimError, find_equilibrium
 from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main
 from aerostat_gym.envs.episodes import TrimTable
@@ -265,6 +265,19 @@ def test_training_on_a_tether_that_cannot_hold_the_task_winds():
         warnings.simplefilter("error")
         assert held_training_winds({"params": load_params()}) == (3.0, 15.0)
         assert held_suite_speeds("tiny", load_params()) is None
+
+
+def test_family_sweep_ends_where_a_member_has_no_trim():
+    """A 0.003x aerostat on 1053 m trimmed 15.5 deg nose up has no trim the solver finds from
+    about 14.4 m/s (it is blown down on a tether that breaks at about 17 m/s): wind_sweep
+    raises TrimError there, and with stop_without_trim (the Figure 9 families) it ends at the
+    last speed that trims, 14 m/s of 0-20, all 15 analyses kept."""
+    p = scale_aerostat(load_params(), 0.003, 1053.0, 6, -15.5)
+    speeds = np.arange(0.0, 21.0, 1.0)
+    with pytest.raises(TrimError, match="no equilibrium found at U = 14"):
+        wind_sweep(p, speeds)
+    sweep = wind_sweep(p, speeds, stop_without_trim=True)
+    assert sweep.values.tolist() == speeds[:15].tolist() and len(sweep.analyses) == 15
 
 
 def test_params_provenance(case, capsys):
@@ -507,6 +520,12 @@ def test_families_and_sensitivity_ranges_follow_the_configuration():
     p = load_params("tcom_32m")
     assert family_values(p, "tether.length") == (300.0, 450.0, 600.0, 750.0)
     assert family_values(p, "aerostat.trim_pitch_deg") == (-8.0, -4.0, 0.0)
+    # a winch limit with more decimals than the family's dedupe rounding: the clamped length
+    # stays on the limit (rounded to 9 decimals it fell 3e-10 m below it and was refused)
+    odd = load_params(overrides={"winch.min_length": 160.00000000012345})
+    lengths = family_values(odd, "tether.length")
+    assert lengths[0] == 160.00000000012345 and lengths[1:] == (225.0, 300.0, 375.0)
+    assert odd.replace(**{"tether.length": lengths[0]}).tether.length == lengths[0]
     knobs = {k.key: k for k in default_knobs(load_params())}
     for key, (lo, hi) in {"fins.planform_area": (12.0, 25.0), "cm_x_shift": (-0.3, 0.3),
                           "hull.eta_k": (0.1, 0.5), "fins.CL_alpha": (1.2, 2.5),

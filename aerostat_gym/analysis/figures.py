@@ -396,7 +396,12 @@ def family_values(params: Params, name: str) -> tuple[float, ...]:
     values = [base * v for v in steps] if kind == "scale" else [base + v for v in steps]
     if name == "tether.length":
         values = [min(max(v, params.winch.min_length), params.winch.max_length) for v in values]
-    return tuple(dict.fromkeys(round(v, 9) for v in values))
+    # one value per distinct (rounded) length; the value itself unrounded, so a length clamped
+    # to a winch limit stays on it
+    distinct = {}
+    for v in values:
+        distinct.setdefault(round(v, 9), v)
+    return tuple(distinct.values())
 
 
 def family_data(params: Params | None, name: str, values=None, speeds=None) -> dict:
@@ -405,7 +410,10 @@ def family_data(params: Params | None, name: str, values=None, speeds=None) -> d
     base = params or load_params()
     values = family_values(base, name) if values is None else values
     speeds = np.arange(0.0, 20.0 + 1e-9, 1.0) if speeds is None else speeds
-    return {float(v): figure9_data(wind_sweep(base.replace(**{name: v}), speeds)) for v in values}
+    # a family member may have no trim at the top speeds (a longer tether under a small
+    # aerostat): its curves end at the last speed that trims
+    return {float(v): figure9_data(wind_sweep(base.replace(**{name: v}), speeds,
+                                              stop_without_trim=True)) for v in values}
 
 
 def plot_family(fam: dict, name: str, path: str | Path) -> Path:

@@ -22,7 +22,7 @@ from ..params import Params, load_params
 from ..physics.core import rotation_matrix
 from ..physics.state import StateLayout
 from .linear import Decoupled, LinearModel, decouple, linearize
-from .trim import Equilibrium, find_equilibrium
+from .trim import Equilibrium, TrimError, find_equilibrium
 
 SETS = ("long", "lat")
 #: |lambda| below this [rad/s] (a period above about 17 h) counts as a neutral rigid-body mode:
@@ -441,21 +441,30 @@ def sweep_analyses(analyses: list[ModalAnalysis], params_list: list[Params], val
     return Sweep(np.asarray(values, float), variable, analyses, tracks, seconds)
 
 
-def wind_sweep(params: Params | None = None, speeds=None, eps: float = 1e-5) -> Sweep:
+def wind_sweep(params: Params | None = None, speeds=None, eps: float = 1e-5,
+               stop_without_trim: bool = False) -> Sweep:
     """Trim, linearize and analyse at every wind speed (continuation from the previous trim).
 
     Parameters
     ----------
     params : parameters (default baseline). speeds : wind speeds [m/s] (default 0:20:0.5, the
     41 speeds of [LN02] Figure 9), increasing. eps : finite-difference step.
+    stop_without_trim : end the sweep at the first speed with no trim (a small aerostat blown
+    down past what its tether holds) instead of raising :class:`TrimError`; the sweep then
+    holds the speeds below it (none trimmed: the error is raised).
     """
     params = params or load_params()
     speeds = np.arange(0.0, 20.0 + 1e-9, 0.5) if speeds is None else np.asarray(speeds, float)
     t0 = time.perf_counter()
     analyses, eq = [], None
     for u in speeds:
-        eq = find_equilibrium(params, float(u), guess=eq)
+        try:
+            eq = find_equilibrium(params, float(u), guess=eq)
+        except TrimError:
+            if not (stop_without_trim and analyses):
+                raise
+            break
         analyses.append(analyse(params, eq, eps))
-    return sweep_analyses(analyses, [params] * len(speeds), speeds, "wind_speed_m_s",
-                          time.perf_counter() - t0)
+    return sweep_analyses(analyses, [params] * len(analyses), speeds[: len(analyses)],
+                          "wind_speed_m_s", time.perf_counter() - t0)
 
