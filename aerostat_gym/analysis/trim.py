@@ -20,6 +20,7 @@ its own tension), continued in wind speed in steps of at most ``max_step`` m/s.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -197,8 +198,9 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
     ``max_step``, or if the solution has a slack tether or the aerostat below the anchor.
     """
     params = params or load_params()
-    if not (math.isfinite(wind_speed) and wind_speed >= 0):
-        raise ValueError(f"wind_speed must be finite and >= 0, got {wind_speed!r}")
+    if not (isinstance(wind_speed, numbers.Real) and math.isfinite(wind_speed)
+            and wind_speed >= 0):
+        raise ValueError(f"wind_speed must be a finite number >= 0 [m/s], got {wind_speed!r}")
     model = Model(params, 0.0)
     if guess is None:
         x, u0 = zero_wind_state(params, length), 0.0
