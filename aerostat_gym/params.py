@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import warnings
 from dataclasses import dataclass, field, fields
 from importlib import resources
@@ -474,6 +475,14 @@ def _config_text(path: str | Path | None) -> tuple[str, str]:
     """(TOML text, source name) of a path, a shipped configuration's name, or the baseline."""
     if path is None:
         path = BASELINE_NAME
+    if isinstance(path, Params):
+        raise ParameterError("load_params takes a TOML path or a shipped configuration's name, "
+                             "got a Params (already loaded: use it, or .replace(...) for changes)")
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"load_params takes a TOML path or a shipped configuration's name "
+                             f"({', '.join(shipped_configs())}), got {type(path).__name__}"
+                             + ("; for a dict of sections use params_from_dict"
+                                if isinstance(path, dict) else ""))
     if not Path(path).is_file() and str(path) in shipped_configs():
         return resources.files("aerostat_gym").joinpath(f"data/{path}.toml").read_text(), str(path)
     path = Path(path)

@@ -105,6 +105,17 @@ def test_unknown_key_missing_key_missing_section(base):
         params_from_dict(data)
 
 
+def test_load_params_refuses_what_is_not_a_path(base):
+    """A dict, a number or an already loaded Params is a ParameterError that says what
+    load_params takes (and, for a dict, where to go), not os's TypeError."""
+    with pytest.raises(ParameterError, match="got dict; for a dict of sections use params_from_dict"):
+        load_params({"tether": {}})
+    with pytest.raises(ParameterError, match="TOML path or a shipped configuration's name .* got float"):
+        load_params(3.0)
+    with pytest.raises(ParameterError, match="got a Params"):
+        load_params(base)
+
+
 def test_user_file_and_overrides(tmp_path, base):
     f = tmp_path / "mine.toml"
     f.write_text(dumps_toml(base).replace("length = 300.0", "length = 350.0"))
