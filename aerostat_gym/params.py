@@ -507,6 +507,12 @@ def load_params(path: str | Path | None = None, overrides: dict[str, Any] | None
     return p
 
 
+
+def as_params(params: Params | str | Path | None) -> Params:
+    """``params`` itself when it is a :class:`Params`, else :func:`load_params` of it (a TOML
+    path, a shipped configuration's name, or None for the baseline)."""
+    return params if isinstance(params, Params) else load_params(params)
+
 STATUSES = ("SOURCED", "DERIVED", "ESTIMATE", "CALIB", "USER")
 USER = "USER"
 

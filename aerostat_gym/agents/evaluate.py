@@ -46,7 +46,7 @@ from ..envs.batch import held_wind_top
 from ..envs.config import DEFAULT_WIND_RANGE
 from ..envs.spaces import N_OBS
 from ..envs.vector import TetheredAerostatVectorEnv
-from ..params import Params, dumps_toml, load_params
+from ..params import as_params, dumps_toml
 from .metrics import response_metrics
 from .policies import load_policy
 from .sb3io import PolicyError
@@ -183,7 +183,7 @@ def default_wind_range(params=None) -> tuple[float, float]:
     lo, hi = DEFAULT_WIND_RANGE
     if params is None:
         return lo, hi
-    params = params if isinstance(params, Params) else load_params(params)
+    params = as_params(params)
     return lo, held_wind_top(params, lo, hi)
 
 
@@ -194,7 +194,7 @@ def held_suite_speeds(name: str, params=None) -> list | None:
     us = sorted({u for speeds, _ in check_suite(name).values() for u in speeds})
     if params is None:
         return None
-    params = params if isinstance(params, Params) else load_params(params)
+    params = as_params(params)
     top = held_wind_top(params, min(us), max(us))
     if top >= max(us):
         return None
@@ -375,7 +375,7 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
     """
     cells = suite_cells(suite, speeds)
     noise = SUITE_OBS_NOISE.get(suite, 0.0)
-    params = params if params is not None and not isinstance(params, str) else load_params(params)
+    params = as_params(params)
     policy = load_policy(policy_name, params=params, dt=control_step, obs_noise=noise,
                          wind_range=default_wind_range(params) if speeds is None
                          else cells_wind_range(cells, params))

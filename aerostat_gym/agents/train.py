@@ -66,7 +66,7 @@ from .. import __version__
 from ..envs.batch import held_wind_top
 from ..envs.config import TaskConfig
 from ..envs.sb3 import sb3_vec_env
-from ..params import Params, dumps_toml, load_params
+from ..params import as_params, dumps_toml
 from ..registration import TASKS
 from ..resources import shipped_path
 from .asymmetric import actor_channels
@@ -183,7 +183,7 @@ def residual_base(spec: dict, env_kwargs: dict):
     if not res:
         return None
     params = env_kwargs.get("params")
-    params = params if isinstance(params, Params) else load_params(params)
+    params = as_params(params)
     return load_policy(res["base"], params=params, dt=float(env_kwargs.get("control_step", 0.2)),
                        obs_noise=res["obs_noise"])
 
