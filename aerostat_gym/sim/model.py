@@ -16,7 +16,7 @@ import numpy as np
 from ..params import Params, load_params
 from ..physics.core import evaluate_tether
 from ..physics.core import rhs as _rhs
-from ..physics.integrators import INTEGRATORS, advance_interval, rk4_step, scheme
+from ..physics.integrators import INTEGRATORS, advance_interval, rk4_interval_step, scheme
 from ..physics.outputs import confluence_tension, winch_tension
 from ..physics.packing import P_FIXED, pack_params
 from ..physics.state import StateLayout, tension_offset, work_size
@@ -120,8 +120,8 @@ class Model:
         compiled interval advance takes it)."""
         d, sim = self.params.derived, self.params.simulation
         L = self.params.tether.length if length is None else length
-        return min(rk4_step(d.EA, d.mass_per_length, L / self.n, sim.rk4_safety, self.n),
-                   sim.semi_implicit_dt)
+        return rk4_interval_step(d.EA, d.mass_per_length, L / self.n, sim.rk4_safety, self.n,
+                                 sim.semi_implicit_dt)
 
     # --- time stepping ---------------------------------------------------------------------
 
