@@ -211,6 +211,13 @@ class TetheredAerostatEnv(gym.Env):
       ``winch.max_length`` (was: ran past it, ending the episode on the length limit); the
       clip limits of the position, length and tension channels grow with the configured
       winch's reach and tether's strength (were the baseline's 400 m, 250 m and 100 kN).
+    - v0 (aerostat-gym 0.7.5; the registered tasks, the baseline and every evaluation
+      unchanged): ``integrator="rk4"`` takes the tether's axial stability bound capped at
+      ``simulation.semi_implicit_dt`` (was the axial bound alone, which on a few long elements
+      under a small hull let the aerodynamics go unstable; the baseline's axial bound, 5.8 ms,
+      is the smaller); ``wind_speed`` and the gust ranges accept a single number, the fixed
+      value (was a ``TaskError``); a reset option ``wind_speed`` that is not a number is a
+      ``TaskError`` quoting it.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
