@@ -269,6 +269,32 @@ def test_vector_env_next_step_autoreset():
     assert np.all(rew == 0.0) and not (term | trunc).any() and "reset_wind_speed" in info
 
 
+def test_vector_env_disabled_autoreset_waits_for_a_masked_reset():
+    """DISABLED: an ended slot reports its end once, then holds its final observation with
+    reward 0 until reset with a mask; the reset slot starts the episode a single env reset with
+    the same seed starts, the other keeps holding."""
+    from gymnasium.vector import AutoresetMode
+
+    venv = gym.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point",
+                        max_episode_steps=3, autoreset_mode=AutoresetMode.DISABLED)
+    venv.reset(seed=5)
+    a = np.full((2, 1), 0.2, np.float32)
+    for _ in range(3):
+        obs, rew, term, trunc, _ = venv.step(a)
+    assert trunc.all() and not term.any()
+    final = obs.copy()
+    venv.reset(seed=[None, None], options={"reset_mask": np.array([False, False])})
+    for _ in range(2):  # nothing reset: both slots hold, report nothing, score nothing
+        obs, rew, term, trunc, info = venv.step(a)
+        assert np.array_equal(obs, final) and np.all(rew == 0.0) and not (term | trunc).any()
+        assert not info["_reward_displacement"].any()
+    obs, _ = venv.reset(seed=[7, None], options={"reset_mask": np.array([True, False])})
+    assert np.array_equal(obs[0], gym.make(ENV_ID).reset(seed=7)[0])
+    assert np.array_equal(obs[1], final[1])
+    with pytest.raises(ValueError, match=r"reset_mask must be a boolean array of shape \(2,\)"):
+        venv.reset(options={"reset_mask": np.array([True, False, True])})
+
+
 def test_sb3_adapter_is_a_vecenv():
     from stable_baselines3.common.vec_env import VecEnv
 

@@ -3,7 +3,8 @@ environments (numba ``prange``; ``NUMBA_NUM_THREADS`` sets the threads).
 
 - :class:`TetheredAerostatVectorEnv`: a ``gymnasium.vector.VectorEnv``, what
   ``gym.make_vec("TetheredAerostat-v0", num_envs=N, vectorization_mode="vector_entry_point")``
-  returns; Gymnasium's autoreset semantics (``NEXT_STEP`` by default, ``SAME_STEP`` on request).
+  returns; Gymnasium's autoreset semantics (``NEXT_STEP`` by default, ``SAME_STEP`` or
+  ``DISABLED`` on request: ``autoreset_mode=...``).
 - :func:`aerostat_gym.envs.sb3.sb3_vec_env`: the same batch as a Stable-Baselines3 ``VecEnv``
   (same-step reset with ``info["terminal_observation"]``), so training needs no subprocesses.
 
@@ -33,7 +34,12 @@ class TetheredAerostatVectorEnv(VectorEnv):
     """``num_envs`` copies of :class:`TetheredAerostatEnv` (same arguments, see its docstring)
     stepped together; ``max_episode_steps`` truncates each episode (600 by default);
     ``threads`` sets the threads of the batched step (1 to ``NUMBA_NUM_THREADS``, default all:
-    on a machine shared with other busy jobs, ``threads=1`` is the safe choice)."""
+    on a machine shared with other busy jobs, ``threads=1`` is the safe choice).
+
+    With ``autoreset_mode=AutoresetMode.DISABLED`` an ended environment waits for
+    ``reset(options={"reset_mask": mask})``: until then it is not stepped, its observation
+    stays the final one and it reports reward 0, ``terminated`` and ``truncated`` False (its
+    end is reported once, on the step where it happened)."""
 
     metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
 
@@ -43,9 +49,6 @@ class TetheredAerostatVectorEnv(VectorEnv):
         if not (isinstance(num_envs, int) and num_envs >= 1):
             raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
         self.autoreset_mode = AutoresetMode(autoreset_mode)
-        if self.autoreset_mode == AutoresetMode.DISABLED:
-            raise ValueError("autoreset_mode DISABLED is not supported; use NEXT_STEP or "
-                             "SAME_STEP")
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"unknown render_mode {render_mode!r}; the vector env renders "
                              "'rgb_array' (environment 0)")
@@ -62,15 +65,15 @@ class TetheredAerostatVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self._rngs = [seeding.np_random(None)[0] for _ in range(num_envs)]
         self._steps = np.zeros(num_envs, dtype=np.int64)
-        self._pending = np.zeros(num_envs, dtype=np.bool_)  # NEXT_STEP: reset at the next step
+        # ended, not stepped: NEXT_STEP resets these at the next step, DISABLED waits for reset()
+        self._pending = np.zeros(num_envs, dtype=np.bool_)
         self._renderer = None
 
     # --- Gymnasium VectorEnv API -----------------------------------------------------------
 
     def reset(self, *, seed=None, options=None):
         opts = dict(options or {})
-        mask = opts.pop("reset_mask", None)
-        mask = np.ones(self.num_envs, bool) if mask is None else np.asarray(mask, bool)
+        mask = _reset_mask(opts.pop("reset_mask", None), self.num_envs)
         seeds = _seeds(seed, self.num_envs)
         infos = []
         for i in np.flatnonzero(mask):
@@ -86,16 +89,16 @@ class TetheredAerostatVectorEnv(VectorEnv):
         pending = self._pending.copy()
         b.step(~pending)
         self._steps[~pending] += 1
-        rewards = b.terms.sum(axis=1)
+        rewards = np.where(pending, 0.0, b.terms.sum(axis=1))
         code = b.code
         terminated = (code != RUNNING) & (code != FIELD_END) & ~pending
         truncated = ((code == FIELD_END) | (self._steps >= self.max_episode_steps)) \
             & ~pending & ~terminated
         info = self._step_info(clipped, pending, terminated, truncated)
         done = terminated | truncated
-        if pending.any():  # NEXT_STEP: these slots start their new episode now
+        if pending.any() and self.autoreset_mode == AutoresetMode.NEXT_STEP:
+            # these slots start their new episode now
             resets = [(i, self._reset(i, {})) for i in np.flatnonzero(pending)]
-            rewards[pending] = 0.0
             info.update(_stack_infos(resets, self.num_envs, prefix="reset_"))
         for i in np.flatnonzero(~pending):
             self._noise(i)
@@ -103,6 +106,8 @@ class TetheredAerostatVectorEnv(VectorEnv):
             self._custom_rewards(rewards, pending, info)
         if self.autoreset_mode == AutoresetMode.NEXT_STEP:
             self._pending = done.copy()
+        elif self.autoreset_mode == AutoresetMode.DISABLED:
+            self._pending |= done
         elif done.any():
             info["final_obs"] = _final_obs(b.obs, done)
             info["_final_obs"] = done.copy()
@@ -180,6 +185,18 @@ def _final_obs(obs: np.ndarray, done: np.ndarray) -> np.ndarray:
     for i in np.flatnonzero(done):
         out[i] = obs[i].copy()
     return out
+
+
+def _reset_mask(mask, n: int) -> np.ndarray:
+    """Which environments ``reset`` resets: all without a mask; else a boolean per
+    environment."""
+    if mask is None:
+        return np.ones(n, dtype=bool)
+    arr = np.asarray(mask)
+    if arr.shape != (n,) or arr.dtype != np.bool_:
+        raise ValueError(f"reset_mask must be a boolean array of shape ({n},), got "
+                         f"{arr.dtype} of shape {arr.shape}")
+    return arr
 
 
 def _seeds(seed, n):
