@@ -14,6 +14,7 @@ are computed in :class:`Derived`, never typed in.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
 import os
 import warnings
@@ -296,7 +297,8 @@ def _build(cls: type, name: str, table: Any) -> Any:
     known = {f.name: f for f in fields(cls)}
     unknown = sorted(set(table) - set(known))
     if unknown:
-        raise ParameterError(f"unknown key(s) in [{name}]: {', '.join(unknown)}")
+        hints = [k + _did_you_mean(k, known) for k in unknown]
+        raise ParameterError(f"unknown key(s) in [{name}]: {', '.join(hints)}")
     missing = sorted(set(known) - set(table))
     if missing:
         raise ParameterError(f"missing key(s) in [{name}]: {', '.join(missing)}")
@@ -424,7 +426,8 @@ def params_from_dict(data: dict) -> Params:
         raise ParameterError("parameter data must be a table")
     unknown = sorted(set(data) - set(SECTIONS))
     if unknown:
-        raise ParameterError(f"unknown section(s): {', '.join(unknown)}")
+        hints = [k + _did_you_mean(k, SECTIONS) for k in unknown]
+        raise ParameterError(f"unknown section(s): {', '.join(hints)}")
     missing = [s for s in SECTIONS if s not in data]
     if missing:
         raise ParameterError(f"missing section(s): {', '.join(missing)}")
@@ -445,16 +448,32 @@ def params_to_dict(p: Params) -> dict:
     return out
 
 
+def parameter_key(data: dict, key: str) -> tuple[str, str]:
+    """``(section, name)`` of a dotted parameter name (``"hull.Cdc"``) in a parameter
+    dictionary (:func:`params_to_dict`); an unknown one is a ParameterError naming the nearest
+    known name."""
+    sec, dot, name = str(key).partition(".")
+    if dot and sec in SECTIONS and name in data[sec]:
+        return sec, name
+    hint = _did_you_mean(str(key), [f"{s}.{k}" for s in SECTIONS for k in data[s]])
+    if not hint:
+        hint = f" (use 'section.key', sections: {', '.join(SECTIONS)})"
+    raise ParameterError(f"unknown parameter {key!r}{hint}")
+
+
+def _did_you_mean(name: str, known) -> str:
+    """`` (did you mean 'X'?)`` for the known name nearest a misspelt one (case ignored:
+    ``cd_c`` finds ``Cdc``), or an empty string."""
+    lower = {k.lower(): k for k in known}
+    close = difflib.get_close_matches(name.lower(), list(lower), 1)
+    return f" (did you mean {lower[close[0]]!r}?)" if close else ""
+
+
 def apply_overrides(p: Params, overrides: dict[str, Any]) -> Params:
     """Replace single values by dotted name (``"tether.length"``), with the same checks as loading."""
     data = params_to_dict(p)
     for key, value in overrides.items():
-        parts = key.split(".")
-        if len(parts) != 2 or parts[0] not in SECTIONS:
-            raise ParameterError(f"unknown parameter {key!r} (use 'section.key', sections: {', '.join(SECTIONS)})")
-        sec, name = parts
-        if name not in data[sec]:
-            raise ParameterError(f"unknown parameter {key!r}")
+        sec, name = parameter_key(data, key)
         data[sec][name] = list(value) if isinstance(value, tuple) else value
     new = params_from_dict(data)
     prov = dict(p.provenance)

@@ -79,6 +79,7 @@ def test_round_trip_through_toml(base):
         ("aerostat.cb_position", [1.0, 2.0], "must be a list of 3 numbers"),
         ("tether.colour", "red", "unknown parameter 'tether.colour'"),
         ("nonsense", 1, "unknown parameter 'nonsense'"),
+        ("hull.cd_c", 0.2, r"unknown parameter 'hull.cd_c' \(did you mean 'hull.Cdc'\?\)"),
     ],
 )
 def test_invalid_values_name_the_field(base, key, value, message):
@@ -89,7 +90,11 @@ def test_invalid_values_name_the_field(base, key, value, message):
 def test_unknown_key_missing_key_missing_section(base):
     data = params_to_dict(base)
     data["hull"]["mystery"] = 1.0
-    with pytest.raises(ParameterError, match=r"unknown key\(s\) in \[hull\]: mystery"):
+    with pytest.raises(ParameterError, match=r"unknown key\(s\) in \[hull\]: mystery$"):
+        params_from_dict(data)
+    data = params_to_dict(base)
+    data["hull"]["cd_c"] = data["hull"].pop("Cdc")  # a typo names the key it was meant to be
+    with pytest.raises(ParameterError, match=r"\[hull\]: cd_c \(did you mean 'Cdc'\?\)"):
         params_from_dict(data)
     data = params_to_dict(base)
     del data["tether"]["strength"]
@@ -101,7 +106,12 @@ def test_unknown_key_missing_key_missing_section(base):
         params_from_dict(data)
     data = params_to_dict(base)
     data["extra"] = {}
-    with pytest.raises(ParameterError, match=r"unknown section\(s\): extra"):
+    with pytest.raises(ParameterError, match=r"unknown section\(s\): extra$"):
+        params_from_dict(data)
+    data = params_to_dict(base)
+    data["tethr"] = data.pop("tether")
+    with pytest.raises(ParameterError, match=r"unknown section\(s\): tethr \(did you mean "
+                                             r"'tether'\?\)"):
         params_from_dict(data)
 
 

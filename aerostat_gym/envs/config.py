@@ -13,7 +13,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..params import ParameterError, Params, apply_overrides, load_params
+from ..params import (
+    SECTIONS,
+    ParameterError,
+    Params,
+    apply_overrides,
+    load_params,
+    parameter_key,
+    params_to_dict,
+)
 from ..sim import INTEGRATORS
 from ..wind.presets import INTENSITY_CLASSES
 from ..wind.sizing import sized_turbulence
@@ -213,10 +221,13 @@ def _check_range_ends(params: Params, key: str, rel: float) -> None:
 def get_parameter(params: Params, key: str):
     """The value of ``section.key`` in a parameter set (TaskError naming an unknown key)."""
     sec, _, name = key.partition(".")
-    try:
+    if sec in SECTIONS and hasattr(getattr(params, sec), name):
         return getattr(getattr(params, sec), name)
-    except AttributeError:
-        raise TaskError(f"unknown parameter {key!r} in randomize") from None
+    try:  # called per reset: the full dictionary only to name the nearest key
+        parameter_key(params_to_dict(params), key)
+    except ParameterError as exc:
+        raise TaskError(f"randomize: {exc}") from None
+    raise TaskError(f"randomize: unknown parameter {key!r}")
 
 
 def perturbation(spec) -> dict:
