@@ -330,7 +330,7 @@ def test_trim_cache_is_bounded(monkeypatch):
 
     def fake_build(params, speeds):
         built.append(params.tether.length)
-        return np.zeros((speeds.size, 3)), np.zeros(speeds.size)
+        return np.zeros((speeds.size, 3)), np.zeros(speeds.size), np.zeros(speeds.size)
 
     monkeypatch.setattr(episodes, "_TRIMS", {})
     monkeypatch.setattr(episodes, "_build_trims", fake_build)

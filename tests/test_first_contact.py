@@ -146,7 +146,7 @@ def test_commands_work_from_any_directory(tmp_path):
      "--policy missing.zip: policy file not found: missing.zip"),
     (["evaluate", "--policy", "pasive"], "unknown policy 'pasive' (did you mean 'passive'?)"),
     (["evaluate", "--policy", "passive", "--speeds", "60"],
-     "--speeds: wind_speed up to 60.0 m/s: the trim at 60.0 m/s loads the winch with"),
+     "--speeds: wind_speed up to 60.0 m/s: the trim at 60.0 m/s loads the tether with"),
     (["train", "--timesteps", "0"], "argument --timesteps: expected an integer >= 1, got '0'"),
     (["train", "--hyperparams", "nope.yml"], "hyperparameter file not found: nope.yml"),
 ])

@@ -53,6 +53,9 @@ from aerostat_gym.analysis.sensitivity import default_knobs
 from aerostat_gym.analysis.trim import TrimError, find_equilibrium
 from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main
+from aerostat_gym.cli.stability import held_speeds
+from aerostat_gym.envs.batch import held_wind_top
+from aerostat_gym.envs.config import TaskError
 from aerostat_gym.envs.episodes import TrimTable
 from aerostat_gym.params import (
     SEMI_IMPLICIT_REFERENCE_DT,
@@ -231,8 +234,8 @@ def test_table2_on_a_one_element_tether():
 
 
 def test_evaluate_on_a_tether_that_cannot_hold_the_default_winds(capsys, tmp_path):
-    """A tether rated 3.3 kN holds the baseline's trims up to 12.3 m/s (3.23 kN at 12 m/s,
-    3.79 kN at 15 m/s): the default wind range's top comes down to the highest 0.1 m/s grid
+    """A tether rated 3.3 kN holds the baseline's trims up to 11.9 m/s (largest tension 3.29 kN
+    there, 3.30 kN at 12 m/s): the default wind range's top comes down to the highest 0.1 m/s grid
     speed it holds, ``evaluate`` on a suite that flies at 15 m/s is refused with the way out
     named, and ``--speeds 5 8`` runs on the winds the aerostat holds."""
     weak = ["--set", "tether.strength=3300", "--set", "winch.safe_working_load=3000"]
@@ -240,8 +243,8 @@ def test_evaluate_on_a_tether_that_cannot_hold_the_default_winds(capsys, tmp_pat
     lo, top = default_wind_range(p)
     trims = TrimTable(p, 3.0, 15.0)
     k = int(np.argmin(np.abs(trims.speeds - top)))
-    assert lo == 3.0 and 12.0 < top < 12.5
-    assert trims.tensions[k] < 3300.0 <= trims.tensions[k + 1]
+    assert lo == 3.0 and top == 11.9
+    assert trims.largest_tensions[k] < 3300.0 <= trims.largest_tensions[k + 1]
     assert default_wind_range(load_params()) == (3.0, 15.0)
     assert main(["evaluate", "--policy", "passive", "--no-plots", "--out", str(tmp_path), *weak]) == 2
     assert "run its scenarios at wind speeds this aerostat holds with --speeds" in capsys.readouterr().err
@@ -251,13 +254,39 @@ def test_evaluate_on_a_tether_that_cannot_hold_the_default_winds(capsys, tmp_pat
     assert sorted(r["wind_speed"] for r in rows) == [5.0, 8.0]
 
 
+def test_the_tether_holds_a_trim_by_its_largest_tension():
+    """One rule decides where the tether breaks at trim: its largest tension, at the top end.
+    A tether rated between the baseline's two end tensions at 15 m/s (3858 N at the confluence
+    point, 3791 N at the winch: the tether's weight between) cannot hold that trim. The
+    environment refuses 15 m/s (it used to judge the winch end, accept it and break on the first
+    step), and its highest held wind is the stability sweep's, 14.8 m/s; there a calm episode
+    does not break."""
+    summary = find_equilibrium(load_params(), 15.0).summary
+    top, winch = summary["top_tension_N"], summary["winch_tension_N"]
+    assert top - winch == pytest.approx(67.3, abs=0.5)
+    rating = 0.5 * (top + winch)
+    p = load_params(overrides={"tether.strength": rating, "winch.safe_working_load": 0.9 * rating,
+                               "winch.max_motor_force": 0.8 * rating})
+    quiet = {"params": p, "turbulence": "none", "perturbation": "none"}
+    with pytest.raises(TaskError, match=r"the trim at 15\.0 m/s loads the tether with 3858 N"):
+        gym.make(ENV_ID, wind_speed=15.0, **quiet)
+    swept = held_speeds(p, np.round(np.arange(3.0, 15.05, 0.1), 1))
+    assert held_wind_top(p, 3.0, 15.0) == swept[-1] == 14.8
+    with pytest.warns(UserWarning, match="winch.max_motor_force"):
+        env = gym.make(ENV_ID, wind_speed=14.8, **quiet)
+    env.reset(seed=0)
+    for _ in range(25):
+        _, _, terminated, _, info = env.step(np.zeros(1, np.float32))
+        assert not terminated and info["peak_tension"] < rating
+
+
 def test_training_on_a_tether_that_cannot_hold_the_task_winds():
-    """Training on the 3.3 kN tether (holds the trims up to 12.3 m/s): the task's (3, 15) m/s
+    """Training on the 3.3 kN tether (holds the trims up to 11.9 m/s): the task's (3, 15) m/s
     comes down to the highest held wind with a warning that says so, and the evaluation suite
     runs its scenarios at the suite's speeds the tether holds (tiny: 5 and 10 m/s of 5, 10,
     15); on the baseline both stay as they are, without a warning."""
     weak = load_params(overrides={"tether.strength": 3300.0, "winch.safe_working_load": 3000.0})
-    with pytest.warns(UserWarning, match=r"holds the trim only up to 12\.\d m/s; training on"):
+    with pytest.warns(UserWarning, match=r"holds the trim only up to 11\.9 m/s; training on"):
         lo, top = held_training_winds({"params": weak, "wind_speed": (3.0, 15.0)})
     assert (lo, top) == default_wind_range(weak)
     assert held_suite_speeds("tiny", weak) == [5.0, 10.0]

@@ -263,6 +263,15 @@ class TrimLimitError(ValueError):
     """A trim the configured tether cannot hold (its tension is above the tether strength)."""
 
 
+def largest_trim_tension(top_tension, winch_tension):
+    """The tension that decides whether the tether holds a trim: the larger of its two ends
+    (in practice the top end: the tether's weight makes its tension fall from the confluence
+    point to the winch, by up to mu g L on a long heavy tether). Scalars or arrays. Every check of a
+    trim against ``tether.strength`` uses it (:func:`limit_warnings`, the environment's wind
+    range), so the sweep, the evaluator and the environment agree where the tether breaks."""
+    return np.maximum(top_tension, winch_tension)
+
+
 def limit_warnings(params: Params, summary: dict) -> list[str]:
     """What the configured winch and tether cannot do at this trim, as warnings.
 
@@ -272,7 +281,7 @@ def limit_warnings(params: Params, summary: dict) -> list[str]:
     safe working load (the over-tension event fires at rest).
     """
     T_w = summary["winch_tension_N"]
-    T_max = max(summary["top_tension_N"], T_w)
+    T_max = float(largest_trim_tension(summary["top_tension_N"], T_w))
     U = summary["wind_speed_m_s"]
     t, w = params.tether, params.winch
     if T_max >= t.strength:

@@ -302,10 +302,11 @@ class EnvBatch:
 
 def held_wind_top(params: Params, lo: float, hi: float) -> float:
     """The highest wind on the 0.1 m/s grid of [lo, hi] whose trim the configured tether holds
-    (winch tension below ``tether.strength``; it grows with the wind), ``hi`` where it holds
-    them all and ``lo`` where it holds none (:func:`trim_table` then names the tension)."""
+    (largest tension below ``tether.strength``, :func:`~aerostat_gym.analysis.trim.
+    largest_trim_tension`; it grows with the wind), ``hi`` where it holds them all and ``lo``
+    where it holds none (:func:`trim_table` then names the tension)."""
     trims = TrimTable(params, lo, hi)
-    held = trims.tensions < params.tether.strength
+    held = trims.largest_tensions < params.tether.strength
     if held.all() or not held[0]:
         return hi if held.all() else lo
     return float(trims.speeds[np.argmin(held) - 1])
@@ -321,11 +322,11 @@ def trim_table(task: TaskConfig) -> TrimTable:
         trims = TrimTable(params, lo, hi)
     except TrimError as exc:
         raise TaskError(f"wind_speed {(lo, hi)}: no trim for these parameters: {exc}") from None
-    k = int(np.argmax(trims.tensions))
-    T, U = float(trims.tensions[k]), float(trims.speeds[k])
+    k = int(np.argmax(trims.largest_tensions))
+    T, U = float(trims.largest_tensions[k]), float(trims.speeds[k])
     strength = params.tether.strength
     if T >= strength:
-        raise TaskError(f"wind_speed up to {hi} m/s: the trim at {U} m/s loads the winch with "
+        raise TaskError(f"wind_speed up to {hi} m/s: the trim at {U} m/s loads the tether with "
                         f"{T:.0f} N, above tether.strength = {strength:.0f} N")
     fmax = params.winch.max_motor_force
     if T > fmax:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.trim import Equilibrium, TrimError, find_equilibrium
+from ..analysis.trim import Equilibrium, TrimError, find_equilibrium, largest_trim_tension
 from ..params import ParameterError, Params, apply_overrides, dumps_toml
 from ..physics.core import euler_angles, rotation_matrix
 from ..physics.packing import pack_params
@@ -63,7 +63,8 @@ class TrimTable:
             while len(_TRIMS) >= MAX_CACHED_TRIMS:
                 del _TRIMS[next(iter(_TRIMS))]  # dicts keep insertion order: the oldest
             _TRIMS[key] = _build_trims(params, self.speeds)
-        self.states, self.tensions = _TRIMS[key]
+        # winch-end tension (the winch's load) and the largest (the tether's, top end) per speed
+        self.states, self.tensions, self.largest_tensions = _TRIMS[key]
 
     def equilibrium(self, k: int) -> Equilibrium:
         return Equilibrium(self.states[k].copy(), float(self.speeds[k]), self.params, 0.0, 0, {})
@@ -72,12 +73,13 @@ class TrimTable:
 def _build_trims(params: Params, speeds: np.ndarray):
     model = Model(params, 0.0)
     eq = find_equilibrium(params, float(speeds[0]))
-    states, tensions = [], []
+    states, ends = [], []
     for s in speeds:
         eq = find_equilibrium(params, float(s), guess=eq, max_step=WIND_GRID)
         states.append(eq.x)
-        tensions.append(model.end_tensions(eq.x)[1])
-    return np.array(states), np.array(tensions)
+        ends.append(model.end_tensions(eq.x))
+    top, winch = np.array(ends).T
+    return np.array(states), winch, largest_trim_tension(top, winch)
 
 
 # --- turbulence bank ---------------------------------------------------------------------------
