@@ -404,7 +404,7 @@ def _advise(p: Params, source: str) -> None:
             f"longer than {advised:.3g} s, the baseline's {SEMI_IMPLICIT_REFERENCE_DT:g} s "
             f"scaled to this {p.aerostat.length:.3g} m hull (aerostat.length; sqrt of the "
             "length ratio): episodes in strong turbulence may end as numerical_divergence (the "
-            "baseline scaled to 0.1x its volume, severe turbulence, random reeling: 19 in "
+            "baseline scaled to 0.1x its volume, severe turbulence, random reeling: 1 in "
             "40,000 steps at 50 ms, none at 34 ms). Set simulation.semi_implicit_dt <= "
             f"{advised:.3g}, or use integrator='rk4'",
             ParameterWarning, stacklevel=3)

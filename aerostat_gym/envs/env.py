@@ -218,6 +218,14 @@ class TetheredAerostatEnv(gym.Env):
       is the smaller); ``wind_speed`` and the gust ranges accept a single number, the fixed
       value (was a ``TaskError``); a reset option ``wind_speed`` that is not a number is a
       ``TaskError`` quoting it.
+    - v0 (aerostat-gym 0.7.6; the integration, observation and reward unchanged where no
+      event is near): a step's ``info["peak_tension"]`` includes its end state (was counted at the
+      start of the next step); a semi-implicit tether break that half the step does not
+      reproduce within 10 % (a slack element snapping taut within one step) is re-integrated
+      until the finer steps agree (was ``numerical_divergence``: on 55 m of tether in 24
+      elements in severe turbulence, 0 failures where there were 13-55 per 9,600 steps); the
+      wind range's trims are judged by the tether's largest tension (was the winch end); the
+      vector env supports ``autoreset_mode=AutoresetMode.DISABLED`` and checks ``reset_mask``.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}

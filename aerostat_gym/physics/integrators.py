@@ -12,7 +12,8 @@
 
 Both return a status code (``OK`` or ``NONFINITE``) and fill ``stats`` with the largest element
 tension seen during the interval (stats[0]) and the smallest over the substeps of the largest
-element tension (stats[1]; zero means the whole tether was slack at some instant).
+element tension (stats[1]; zero means the whole tether was slack at some instant);
+:func:`advance_interval` adds the interval's end state to both.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .core import FASTMATH, _rotation, rhs
+from .core import FASTMATH, _rotation, evaluate_tether, rhs
 from .packing import P_DASHPOT, P_EA, P_FIXED, P_INERTIA, P_LEASH, P_ME, P_MU, P_NEL
 from .state import (
     S_LENGTH,
@@ -414,5 +415,12 @@ def advance_interval(x, t, interval, u, p, wp, wf, w, sch, stats):
     nsteps = max(1, int(math.ceil(interval / h_max - 1e-9)))
     h = interval / nsteps
     if semi:
-        return si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats)
-    return rk4_advance(x, t, h, nsteps, u, p, wp, wf, w, stats)
+        status = si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats)
+    else:
+        status = rk4_advance(x, t, h, nsteps, u, p, wp, wf, w, stats)
+    if status == OK:
+        # the interval's end state belongs to it: a tension its last step drives past the
+        # strength is this interval's event, which a re-run of the interval can still resolve
+        evaluate_tether(t + interval, x, p, wp, wf, w)
+        _tension_stats(w, n, stats)
+    return status
