@@ -118,7 +118,8 @@ class TaskConfig:
             raise TaskError(f"unknown integrator {self.integrator!r}; choose one of {INTEGRATORS}")
         dt = _positive("control_step", self.control_step)
         if dt > 1.0:
-            raise TaskError(f"control_step must be <= 1 s (the axial mode is ~3 s), got {dt!r}")
+            raise TaskError(f"control_step must be <= 1 s (a reel command held longer cannot act "
+                            f"on the pitch and axial modes, ~3 s on the baseline), got {dt!r}")
         if self.observation not in ("standard", "full"):
             raise TaskError(f"unknown observation {self.observation!r}; choose 'standard' or "
                             "'full'")
