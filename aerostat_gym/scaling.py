@@ -29,7 +29,14 @@ from __future__ import annotations
 
 import math
 
-from .params import ParameterError, Params, froude_step, params_from_dict, params_to_dict
+from .params import (
+    ParameterError,
+    Params,
+    froude_step,
+    params_from_dict,
+    params_to_dict,
+    tether_drag_step,
+)
 
 #: Winch length limits as fractions of the nominal tether length (the baseline's 150 / 400 m
 #: for 300 m).
@@ -96,7 +103,11 @@ def scale_aerostat(params: Params, volume_factor: float, tether_length: float,
     w["max_length"] = WINCH_MAX_FRACTION * tether_length
     w["total_line_length"] = w["max_length"]
     d["wind"]["turbulence_reference_height"] = float(tether_length)
-    d["simulation"]["semi_implicit_dt"] = froude_step(d["simulation"]["semi_implicit_dt"], s)
+    # Froude time scaling, and no longer than the thinner line's explicit drag allows
+    d["simulation"]["semi_implicit_dt"] = min(
+        froude_step(d["simulation"]["semi_implicit_dt"], s),
+        tether_drag_step(t["diameter"], t["density"], t["Cd_normal"],
+                         d["environment"]["rho_air"]))
     if n_elements is not None:
         t["n_elements"] = int(n_elements)
     if trim_pitch_deg is not None:

@@ -67,6 +67,7 @@ from aerostat_gym.params import (
     load_params,
     parameter_table,
     params_from_dict,
+    tether_drag_step,
     tomllib,
 )
 from aerostat_gym.registration import ENV_ID
@@ -664,6 +665,23 @@ def test_schedules_stop_where_the_winch_motor_cannot_hold_the_trim():
         held_trims(p.replace(**{"winch.max_motor_force": 1.0}), [5.0, 6.0])
 
 
+def test_tether_drag_step_is_the_explicit_euler_bound():
+    """tether_drag_step is 2 / lambda, lambda = 2 rho Cd d v / mu at v = 15 m/s, computed here
+    by hand for the baseline's 6 mm line (0.192 s: not the bound, the Froude 50 ms is) and for
+    the 0.0035x aerostat's 0.355 mm line (11.3 ms, below its Froude 19.5 ms, which ended 11 of
+    its 8 x 500 severe-turbulence steps at 17-25 m/s as numerical failures)."""
+    base = load_params()
+    for factor, want_ms in ((1.0, 191.7), (0.0035, 11.34)):
+        p = scale_aerostat(base, volume_factor=factor, tether_length=409.0)
+        t, rho = p.tether, p.environment.rho_air
+        lam = 2.0 * rho * t.Cd_normal * t.diameter * 15.0 / (t.density * math.pi * t.diameter**2 / 4)
+        got = tether_drag_step(t.diameter, t.density, t.Cd_normal, rho)
+        assert got == pytest.approx(2.0 / lam, rel=1e-12) and 1000 * got == pytest.approx(want_ms, abs=0.05)
+    tiny = scale_aerostat(base, volume_factor=0.0035, tether_length=409.0)
+    assert tiny.simulation.semi_implicit_dt == pytest.approx(0.01134, abs=1e-5)
+    assert advised_semi_implicit_dt(base) == 0.05
+
+
 def test_a_small_aerostat_file_with_the_baseline_step_warns_at_load(tmp_path):
     """A TOML of the baseline scaled to 0.1x its volume (8.49 m hull) that keeps the 50 ms
     semi-implicit step warns once at load, naming the field, its value and the advised
@@ -713,7 +731,8 @@ def test_the_advised_step_removes_the_small_aerostats_numerical_failures():
 def test_scaling_laws(factor):
     """Geometric similarity with s = factor^(1/3) (aerostat_gym.scaling): lengths x s, areas
     x s^2, masses, volumes and the tether's strength x s^3, inertias x s^5 (rel 1e-12); the
-    semi-implicit step x sqrt(s) below the source's size, unchanged above it."""
+    semi-implicit step x sqrt(s) below the source's size, unchanged above it, and no longer
+    than the thinner line's drag bound (0.01x: 19.3 ms against the Froude 23.2 ms)."""
     base = load_params()
     p = scale_aerostat(base, volume_factor=factor, tether_length=250.0)
     s = factor ** (1.0 / 3.0)
@@ -724,7 +743,9 @@ def test_scaling_laws(factor):
              (p.tether.strength, base.tether.strength * s**3),
              (p.aerostat.Iyy, base.aerostat.Iyy * s**5),
              (p.simulation.semi_implicit_dt,
-              base.simulation.semi_implicit_dt * min(1.0, math.sqrt(s)))]
+              min(base.simulation.semi_implicit_dt * min(1.0, math.sqrt(s)),
+                  tether_drag_step(p.tether.diameter, p.tether.density, p.tether.Cd_normal,
+                                   p.environment.rho_air)))]
     for got, want in pairs:
         assert got == pytest.approx(want, rel=1e-12)
     assert p.tether.length == 250.0 and p.winch.max_length == pytest.approx(250.0 * 4 / 3)

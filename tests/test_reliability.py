@@ -299,8 +299,8 @@ def test_6_rk4_past_its_stability_step_is_a_numerical_failure():
 def test_6_rk4_on_few_long_elements_is_capped_at_the_aerostats_step():
     """Two elements on 884 m under a 0.011x hull: the tether's axial RK4 bound is 0.119 s,
     but the aerostat's fastest aerodynamic rate reaches 35.5 /s at 25 m/s (|lambda| h = 4.2,
-    past RK4's 2.8); the step is capped at simulation.semi_implicit_dt (0.0236 s, the
-    Froude-scaled step). At the axial bound (the step before the cap) the 1,600 random-reeling
+    past RK4's 2.8); the step is capped at simulation.semi_implicit_dt (0.0201 s, the thin
+    line's drag bound, below the Froude-scaled 0.0236 s). At the axial bound (the step before the cap) the 1,600 random-reeling
     steps below at 20-25 m/s end 7 episodes as numerical failures; capped, none."""
     from aerostat_gym.physics.integrators import rk4_step
     from aerostat_gym.scaling import scale_aerostat

@@ -1,0 +1,83 @@
+"""Episode ends on generated aerostats in severe turbulence (the semi-implicit step's reach).
+
+    python scripts/generated_aerostats.py --seed 7 --count 16
+
+Each aerostat is the baseline scaled by ``scale_aerostat`` to a random volume (10^-2.5 to 10x),
+tether length (30-2000 m), element count (2-29) and trim pitch (-6 to 0 deg), with the step
+``scale_aerostat`` writes. It flies 8 environments x 500 control steps of uniform random reel
+commands in [-1.5, 1.5] in severe turbulence, at mean winds in the 8 m/s below the highest
+(up to 25 m/s) whose trim its tether holds, with randomised parameters. Printed per aerostat:
+h x lambda (the step times the tether drag's rate 2 rho Cd d v / mu at v = 12.5 m/s, the
+quantity :func:`aerostat_gym.params.tether_drag_step` bounds) and the terminations by reason.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import warnings
+from collections import Counter
+
+import gymnasium as gym
+import numpy as np
+
+import aerostat_gym  # noqa: F401  (registers the environment)
+from aerostat_gym.envs.batch import held_wind_top
+from aerostat_gym.params import load_params
+from aerostat_gym.registration import ENV_ID
+from aerostat_gym.scaling import scale_aerostat
+
+N_ENVS, STEPS, TOP_WIND, SPAN = 8, 500, 25.0, 8.0
+
+
+def drag_rate_step(p, speed: float = 12.5) -> float:
+    """h x lambda of the tether drag at a normal air speed ``speed``."""
+    t, rho = p.tether, p.environment.rho_air
+    mu = t.density * math.pi * t.diameter**2 / 4.0
+    return p.simulation.semi_implicit_dt * 2.0 * rho * t.Cd_normal * t.diameter * speed / mu
+
+
+def run(p, seed: int) -> tuple[Counter, tuple[float, float]]:
+    """Terminations by reason of one aerostat's random-reeling run, and its wind range."""
+    top = held_wind_top(p, 3.0, TOP_WIND)
+    winds = (max(3.0, top - SPAN), top)
+    counts = Counter()
+    env = gym.make_vec(ENV_ID, num_envs=N_ENVS, vectorization_mode="vector_entry_point",
+                       params=p, wind_speed=winds, turbulence="severe", randomize=True)
+    env.reset(seed=seed)
+    rng = np.random.default_rng(seed)
+    for _ in range(STEPS):
+        _, _, _, _, info = env.step(rng.uniform(-1.5, 1.5, (N_ENVS, 1)).astype(np.float32))
+        if "termination" in info:
+            counts.update(info["termination"][info["_termination"]])
+    env.close()
+    return counts, winds
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seed", type=int, default=7, help="seed of the generated aerostats")
+    ap.add_argument("--count", type=int, default=16, help="aerostats to generate")
+    args = ap.parse_args()
+    warnings.simplefilter("ignore")  # winch-limit and parameter warnings of extreme aerostats
+    rng = np.random.default_rng(args.seed)
+    total = Counter()
+    for k in range(args.count):
+        factor = float(10 ** rng.uniform(-2.5, 1.0))
+        length = float(rng.uniform(30.0, 2000.0))
+        elements = int(rng.integers(2, 30))
+        pitch = float(rng.uniform(-6.0, 0.0))
+        p = scale_aerostat(load_params(), factor, length, elements, pitch)
+        if held_wind_top(p, 3.0, TOP_WIND) <= 3.0:
+            print(f"{factor:8.4f}x {length:6.0f} m: the tether holds no wind above 3 m/s")
+            continue
+        counts, winds = run(p, k)
+        total.update(counts)
+        print(f"h*lambda {drag_rate_step(p):4.2f}  {factor:8.4f}x {length:6.0f} m n={elements:2d} "
+              f"dt={1000 * p.simulation.semi_implicit_dt:4.1f} ms  winds {winds[0]:.1f}-"
+              f"{winds[1]:.1f}: {dict(counts) or 'no termination'}", flush=True)
+    print("total", dict(total))
+
+
+if __name__ == "__main__":
+    main()
