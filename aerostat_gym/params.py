@@ -404,7 +404,7 @@ def tether_drag_step(diameter: float, density: float, Cd_normal: float, rho_air:
     step: 0.19 s for the baseline's 6 mm line (not the bound), 11 ms for a 0.35 mm one."""
     mu = density * math.pi * diameter**2 / 4.0
     rate = 2.0 * rho_air * Cd_normal * diameter * TETHER_DRAG_REFERENCE_SPEED / mu
-    return 2.0 / rate
+    return 2.0 / rate if rate > 0.0 else math.inf  # a drag-free line sets no bound
 
 
 def advised_semi_implicit_dt(p: Params) -> float:

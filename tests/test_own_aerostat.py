@@ -680,6 +680,7 @@ def test_tether_drag_step_is_the_explicit_euler_bound():
     tiny = scale_aerostat(base, volume_factor=0.0035, tether_length=409.0)
     assert tiny.simulation.semi_implicit_dt == pytest.approx(0.01134, abs=1e-5)
     assert advised_semi_implicit_dt(base) == 0.05
+    assert tether_drag_step(0.006, 840.0, 0.0, 1.147) == math.inf  # a drag-free line: no bound
 
 
 def test_a_small_aerostat_file_with_the_baseline_step_warns_at_load(tmp_path):
