@@ -295,6 +295,15 @@ def test_vector_env_disabled_autoreset_waits_for_a_masked_reset():
         venv.reset(options={"reset_mask": np.array([True, False, True])})
 
 
+@pytest.mark.parametrize("steps", [0, -5, 2.5])
+def test_vector_env_refuses_a_bad_episode_limit(steps):
+    """max_episode_steps 0 used to mean the default 600 and a negative one truncated every step;
+    both, and a non-integer, are refused naming the argument."""
+    with pytest.raises(ValueError, match=rf"max_episode_steps must be an integer >= 1, got {steps}"):
+        gym.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point",
+                     max_episode_steps=steps)
+
+
 def test_sb3_adapter_is_a_vecenv():
     from stable_baselines3.common.vec_env import VecEnv
 

@@ -225,7 +225,8 @@ class TetheredAerostatEnv(gym.Env):
       until the finer steps agree (was ``numerical_divergence``: on 55 m of tether in 24
       elements in severe turbulence, 0 failures where there were 13-55 per 9,600 steps); the
       wind range's trims are judged by the tether's largest tension (was the winch end); the
-      vector env supports ``autoreset_mode=AutoresetMode.DISABLED`` and checks ``reset_mask``.
+      vector env supports ``autoreset_mode=AutoresetMode.DISABLED``, checks ``reset_mask`` and
+      refuses a ``max_episode_steps`` below 1 (0 meant 600, a negative one truncated every step).
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}

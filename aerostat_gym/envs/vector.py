@@ -55,7 +55,12 @@ class TetheredAerostatVectorEnv(VectorEnv):
         self.render_mode = render_mode
         self.metadata = {**self.metadata, "autoreset_mode": self.autoreset_mode}
         self.task = TaskConfig.from_kwargs(**kwargs)
-        self.max_episode_steps = int(max_episode_steps or DEFAULT_MAX_EPISODE_STEPS)
+        if max_episode_steps is None:
+            max_episode_steps = DEFAULT_MAX_EPISODE_STEPS
+        if isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, (int, np.integer)) \
+                or max_episode_steps < 1:
+            raise ValueError(f"max_episode_steps must be an integer >= 1, got {max_episode_steps!r}")
+        self.max_episode_steps = int(max_episode_steps)
         self.num_envs = num_envs
         self.batch = EnvBatch(self.task, num_envs, threads)
         b = self.batch
