@@ -95,9 +95,16 @@ def observe(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs):
     Channels in :data:`aerostat_gym.envs.spaces.CHANNELS` order: attitude deviations are
     theta - theta_trim etc. unchanged in sign (theta < 0 is nose up).
     """
+    evaluate_tether(t, x, p, wp, wf, w)
+    return _observe_evaluated(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)
+
+
+@njit(**_JIT)
+def _observe_evaluated(x, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs):
+    """:func:`observe` with the work array already holding state x at time t (as
+    :func:`~aerostat_gym.physics.integrators.advance_interval` leaves its end state)."""
     n = int(p[P_NEL])
     o = aerostat_offset(n)
-    evaluate_tether(t, x, p, wp, wf, w)
     T_w = winch_tension(x, p, w)
     ax, ay, az = air_velocity(x[o + S_X], x[o + S_X + 1], x[o + S_X + 2], t, wp, wf)
     raw = np.empty(S.N_OBS)
@@ -162,7 +169,9 @@ def _step_one(x, x_prev, t, a, a_prev, braked, quiet, p, wp, wf, w, cfg, x_trim,
     if status == NONFINITE:
         return _failed(E.NONFINITE, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo,
                        hi, obs, terms), brake, quiet, 0.0
-    if not math.isfinite(observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi, obs)):
+    # advance_interval has evaluated the tether at the end state into w
+    if not math.isfinite(_observe_evaluated(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale,
+                                            lo, hi, obs)):
         return _failed(E.NONFINITE_OUTPUT, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim,
                        scale, lo, hi, obs, terms), brake, quiet, 0.0
     code = E.step_outcome(x, t1, p, stats[0], cfg[C_GROUND], cfg[C_HORIZON])
