@@ -14,7 +14,6 @@ quantity :func:`aerostat_gym.params.tether_drag_step` bounds) and the terminatio
 from __future__ import annotations
 
 import argparse
-import math
 import warnings
 from collections import Counter
 
@@ -23,7 +22,7 @@ import numpy as np
 
 import aerostat_gym  # noqa: F401  (registers the environment)
 from aerostat_gym.envs.batch import held_wind_top
-from aerostat_gym.params import load_params
+from aerostat_gym.params import TETHER_DRAG_REFERENCE_SPEED, load_params, tether_drag_step
 from aerostat_gym.registration import ENV_ID
 from aerostat_gym.scaling import scale_aerostat
 
@@ -31,10 +30,11 @@ N_ENVS, STEPS, TOP_WIND, SPAN = 8, 500, 25.0, 8.0
 
 
 def drag_rate_step(p, speed: float = 12.5) -> float:
-    """h x lambda of the tether drag at a normal air speed ``speed``."""
-    t, rho = p.tether, p.environment.rho_air
-    mu = t.density * math.pi * t.diameter**2 / 4.0
-    return p.simulation.semi_implicit_dt * 2.0 * rho * t.Cd_normal * t.diameter * speed / mu
+    """h x lambda of the tether drag at a normal air speed ``speed`` (lambda grows with the
+    speed; tether_drag_step is 2 / lambda at TETHER_DRAG_REFERENCE_SPEED)."""
+    t = p.tether
+    bound = tether_drag_step(t.diameter, t.density, t.Cd_normal, p.environment.rho_air)
+    return p.simulation.semi_implicit_dt * 2.0 / bound * speed / TETHER_DRAG_REFERENCE_SPEED
 
 
 def run(p, seed: int) -> tuple[Counter, tuple[float, float]]:

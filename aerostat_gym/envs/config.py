@@ -222,13 +222,12 @@ def _check_range_ends(params: Params, key: str, rel: float) -> None:
 def get_parameter(params: Params, key: str):
     """The value of ``section.key`` in a parameter set (TaskError naming an unknown key)."""
     sec, _, name = key.partition(".")
-    if sec in SECTIONS and hasattr(getattr(params, sec), name):
-        return getattr(getattr(params, sec), name)
-    try:  # called per reset: the full dictionary only to name the nearest key
-        parameter_key(params_to_dict(params), key)
-    except ParameterError as exc:
-        raise TaskError(f"randomize: {exc}") from None
-    raise TaskError(f"randomize: unknown parameter {key!r}")
+    if sec not in SECTIONS or not hasattr(getattr(params, sec), name):
+        try:  # called per reset: the full dictionary only to name the nearest key
+            parameter_key(params_to_dict(params), key)
+        except ParameterError as exc:
+            raise TaskError(f"randomize: {exc}") from None
+    return getattr(getattr(params, sec), name)
 
 
 def perturbation(spec) -> dict:
