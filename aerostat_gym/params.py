@@ -18,12 +18,15 @@ import difflib
 import math
 import os
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from .checks import is_number, is_whole
 
 try:  # Python >= 3.11
     import tomllib
@@ -239,15 +242,11 @@ POST_STALL_MODELS = ("viterna", "flat")
 # --- validation ----------------------------------------------------------------------------------
 
 
-def _is_number(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool)
-
-
 def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
     """Coerce and check one value against its field's declared type and constraint."""
     check = f.metadata["check"]
     if check == VEC3:
-        if not (isinstance(value, (list, tuple)) and len(value) == 3 and all(map(_is_number, value))):
+        if not (isinstance(value, (list, tuple)) and len(value) == 3 and all(map(is_number, value))):
             raise ParameterError(f"{name} must be a list of 3 numbers, got {value!r}")
         value = tuple(float(v) for v in value)
         if not all(math.isfinite(v) for v in value):
@@ -255,7 +254,7 @@ def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
         return value
     if check == COEFFS:
         size = f.metadata["size"]
-        if not (isinstance(value, (list, tuple)) and value and all(map(_is_number, value))):
+        if not (isinstance(value, (list, tuple)) and value and all(map(is_number, value))):
             raise ParameterError(f"{name} must be a list of {size} numbers, got {value!r}")
         if len(value) != size:
             raise ParameterError(f"{name} needs {size} coefficients, got {len(value)}: {value!r}")
@@ -273,11 +272,11 @@ def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
             raise ParameterError(f"{name} must be true or false, got {value!r}")
         return value
     if check == INT_GE1:
-        if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_ELEMENTS:
+        if not is_whole(value, 1, MAX_ELEMENTS):
             raise ParameterError(f"{name} must be an integer >= 1 and <= {MAX_ELEMENTS}, got "
                                  f"{value!r}")
         return int(value)
-    if not _is_number(value):
+    if not is_number(value):
         raise ParameterError(f"{name} must be a number, got {value!r}")
     value = float(value)
     if not math.isfinite(value):
@@ -496,6 +495,9 @@ def _did_you_mean(name: str, known) -> str:
 
 def apply_overrides(p: Params, overrides: dict[str, Any]) -> Params:
     """Replace single values by dotted name (``"tether.length"``), with the same checks as loading."""
+    if not isinstance(overrides, Mapping):
+        raise ParameterError("overrides must map dotted parameter names to values, e.g. "
+                             f"{{'tether.length': 300.0}}; got {overrides!r}")
     data = params_to_dict(p)
     for key, value in overrides.items():
         sec, name = parameter_key(data, key)

@@ -27,8 +27,7 @@ aerostat breaks its tether; check the strength of a scaled-down tether against y
 
 from __future__ import annotations
 
-import math
-
+from .checks import is_finite_number
 from .params import (
     ParameterError,
     Params,
@@ -70,9 +69,9 @@ def scale_aerostat(params: Params, volume_factor: float, tether_length: float,
     -------
     Params, validated like a loaded file.
     """
-    if not (math.isfinite(volume_factor) and volume_factor > 0):
+    if not (is_finite_number(volume_factor) and volume_factor > 0):
         raise ParameterError(f"volume_factor must be a finite number > 0, got {volume_factor!r}")
-    if not (math.isfinite(tether_length) and tether_length > 0):
+    if not (is_finite_number(tether_length) and tether_length > 0):
         raise ParameterError(f"tether_length must be a finite number > 0, got {tether_length!r}")
     s = volume_factor ** (1.0 / 3.0)
     d = params_to_dict(params)
@@ -108,8 +107,8 @@ def scale_aerostat(params: Params, volume_factor: float, tether_length: float,
         froude_step(d["simulation"]["semi_implicit_dt"], s),
         tether_drag_step(t["diameter"], t["density"], t["Cd_normal"],
                          d["environment"]["rho_air"]))
-    if n_elements is not None:
-        t["n_elements"] = int(n_elements)
+    if n_elements is not None:  # checked, like the trim pitch, as if typed into the file
+        t["n_elements"] = n_elements
     if trim_pitch_deg is not None:
-        a["trim_pitch_deg"] = float(trim_pitch_deg)
+        a["trim_pitch_deg"] = trim_pitch_deg
     return params_from_dict(d)

@@ -37,6 +37,7 @@ import math
 
 import numpy as np
 
+from ..checks import is_number
 from .evaluate import SCENARIOS
 from .policies import BASELINES
 from .protocol_stats import (
@@ -135,7 +136,7 @@ def cell_values(result: dict, scenario: str, speed: float, metric: str) -> tuple
                   if e["wind_speed"] == speed), key=lambda e: (e.get("group", 0), e["seed"]))
     vals = [e.get(metric) for e in eps]
     return [e["seed"] for e in eps], np.array(
-        [v if isinstance(v, (int, float)) and not isinstance(v, bool) else np.nan for v in vals],
+        [v if is_number(v) else np.nan for v in vals],
         float)
 
 

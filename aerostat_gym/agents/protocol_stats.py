@@ -37,6 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from ..checks import is_finite_number, is_whole
+
 #: Bootstrap resamples of every interval unless the caller says otherwise.
 DEFAULT_RESAMPLES = 4000
 #: Confidence level of every interval unless the caller says otherwise.
@@ -110,9 +112,9 @@ def _matrix(x, name: str) -> np.ndarray:
 
 
 def _check_level(confidence: float, resamples: int) -> None:
-    if not (isinstance(confidence, float | int) and 0.0 < confidence < 1.0):
+    if not (is_finite_number(confidence) and 0.0 < confidence < 1.0):
         raise StatsInputError(f"confidence must lie in (0, 1), got {confidence!r}")
-    if not (isinstance(resamples, int | np.integer) and resamples >= 100):
+    if not is_whole(resamples, 100):
         raise StatsInputError(f"resamples must be an integer >= 100, got {resamples!r}")
 
 
@@ -260,7 +262,7 @@ def stratified_resample(scores: np.ndarray, rng: np.random.Generator) -> np.ndar
 
 def _check_groups(scores: np.ndarray, groups: int, name: str) -> int:
     """The number of equal row blocks (training seeds) of a (runs, tasks) matrix."""
-    if isinstance(groups, bool) or not isinstance(groups, int | np.integer) or groups < 1:
+    if not is_whole(groups):
         raise StatsInputError(f"{name}: groups must be an integer >= 1, got {groups!r}")
     if scores.shape[0] % groups or (groups > 1 and scores.shape[0] // groups < 2):
         raise StatsInputError(f"{name}: {scores.shape[0]} runs do not split into {groups} "

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import is_number
 from ..resources import SHIPPED_POLICY
 from . import protocol as proto_mod
 from .evaluate import SCENARIOS, describe_suite, evaluate_policy
@@ -300,8 +301,7 @@ def cell_means(episodes: list[dict]) -> list[dict]:
         cell = {"wind_speed": u, "n_seeds": len(eps)}
         for key in eps[0]:
             vals = [e[key] for e in eps]
-            if key in ("wind_speed", "seed") or not all(
-                    isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
+            if key in ("wind_speed", "seed") or not all(map(is_number, vals)):
                 continue
             x = np.array([v for v in vals if math.isfinite(v)], dtype=float)
             if x.size == 0:

@@ -21,10 +21,9 @@ forms (``lqg``, ``modal_lqg``: the same gains on a Kalman filter's estimate) are
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from ..checks import is_finite_number
 from ..envs.spaces import N_OBS
 from .sb3io import CommandShaper, PolicyError, check_lowpass_on
 
@@ -59,8 +58,7 @@ def check_residual(spec) -> dict:
     if base not in RESIDUAL_BASES:
         raise PolicyError(f"unknown residual base {base!r}; choose one of {RESIDUAL_BASES}")
     scale = spec.get("scale", 0.3)
-    if isinstance(scale, bool) or not isinstance(scale, (int, float)) \
-            or not math.isfinite(scale) or not 0 < scale <= 2:
+    if not (is_finite_number(scale) and 0 < scale <= 2):
         raise PolicyError(f"residual scale must be a number in (0, 2], got {scale!r}")
     out = {"base": base, "scale": float(scale)}
     if "deadband" in spec:
@@ -87,8 +85,7 @@ def check_observe_estimate(flag, base: str) -> bool:
 
 def check_lowpass(tau) -> float:
     """A command low-pass time constant [s] in [0, MAX_LOWPASS] (0: no filter)."""
-    if isinstance(tau, bool) or not isinstance(tau, (int, float)) or not math.isfinite(tau) \
-            or not 0 <= tau <= MAX_LOWPASS:
+    if not (is_finite_number(tau) and 0 <= tau <= MAX_LOWPASS):
         raise PolicyError(f"residual lowpass is a time constant in [0, {MAX_LOWPASS:g}] s, "
                           f"got {tau!r}")
     return float(tau)
@@ -102,8 +99,7 @@ def residual_shaper(spec: dict, dt: float) -> CommandShaper:
 
 def check_deadband(d) -> float:
     """A deadband: a fraction of the winch's top speed in [0, 1)."""
-    if isinstance(d, bool) or not isinstance(d, (int, float)) or not math.isfinite(d) \
-            or not 0 <= d < 1:
+    if not (is_finite_number(d) and 0 <= d < 1):
         raise PolicyError(f"residual deadband is a fraction of the winch's top speed in [0, 1), "
                           f"got {d!r}")
     return float(d)

@@ -19,10 +19,9 @@ unbounded weight would train on noise.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from ..checks import is_finite_number
 from ..envs.reference import BrakedReference
 from ..envs.vector import TetheredAerostatVectorEnv
 from .sb3io import PolicyError, find_in_chain
@@ -45,8 +44,7 @@ def check_score_reward(spec) -> dict | None:
     if not isinstance(spec, dict) or set(spec) - SCORE_REWARD_KEYS:
         raise PolicyError(f"score_reward must be true, false or {{floor: F}}, got {spec!r}")
     floor = spec.get("floor", DEFAULT_FLOOR)
-    if isinstance(floor, bool) or not isinstance(floor, (int, float)) \
-            or not math.isfinite(floor) or floor <= 0:
+    if not (is_finite_number(floor) and floor > 0):
         raise PolicyError(f"score_reward floor must be a finite number > 0, got {floor!r}")
     return {"floor": float(floor)}
 

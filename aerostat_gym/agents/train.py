@@ -52,7 +52,6 @@ from __future__ import annotations
 
 import ast
 import json
-import math
 import platform
 import shlex
 import sys
@@ -63,6 +62,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..checks import is_finite_number, is_whole
 from ..envs.batch import held_wind_top
 from ..envs.config import TaskConfig
 from ..envs.sb3 import sb3_vec_env
@@ -164,7 +164,7 @@ def wrapper_spec(project: dict, env_kwargs: dict) -> dict:
     {"base", "scale", "obs_noise"}} (the residual's sensor noise is the training
     environment's, which its base is designed for)."""
     k = project.get("frame_stack", 1)
-    if isinstance(k, bool) or not isinstance(k, int) or not 1 <= k <= 64:
+    if not is_whole(k, 1, 64):
         raise TrainingError(f"frame_stack must be an integer in [1, 64], got {k!r}")
     spec = {"frame_stack": k}
     if project.get("residual") is not None:
@@ -230,8 +230,7 @@ def run_policy(model, wrappers: dict, base=None, dt: float = 0.2) -> SB3Policy:
 def _count(name: str, value) -> int:
     """A step or environment count: an integer >= 1 (0 and negatives are refused, not read as
     'use the default')."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-            or value != int(value) or value < 1:
+    if not (is_finite_number(value) and value == int(value) and value >= 1):
         raise TrainingError(f"{name} must be an integer >= 1, got {value!r}")
     return int(value)
 

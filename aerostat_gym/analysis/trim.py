@@ -20,15 +20,16 @@ its own tension), continued in wind speed in steps of at most ``max_step`` m/s.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
+from ..checks import is_finite_number
 from ..params import Params, load_params
 from ..physics.core import rotation_matrix
+from ..physics.wind import MAX_WIND_SPEED
 from ..sim import Model
 
 REL_TOL = 1e-9
@@ -198,9 +199,10 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
     ``max_step``, or if the solution has a slack tether or the aerostat below the anchor.
     """
     params = params or load_params()
-    if not (isinstance(wind_speed, numbers.Real) and math.isfinite(wind_speed)
-            and wind_speed >= 0):
-        raise ValueError(f"wind_speed must be a finite number >= 0 [m/s], got {wind_speed!r}")
+    if not (is_finite_number(wind_speed) and 0 <= wind_speed <= MAX_WIND_SPEED):
+        raise ValueError(f"wind_speed must be a number in [0, {MAX_WIND_SPEED:g}] m/s (the "
+                         f"model's incompressible aerodynamics end near Mach 0.3), got "
+                         f"{wind_speed!r}")
     model = Model(params, 0.0)
     if guess is None:
         x, u0 = zero_wind_state(params, length), 0.0

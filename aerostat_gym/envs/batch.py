@@ -12,6 +12,7 @@ import numba
 import numpy as np
 
 from ..analysis.trim import TrimError
+from ..checks import is_whole
 from ..params import Params
 from ..physics.integrators import scheme
 from ..physics.outputs import winch_tension
@@ -34,8 +35,7 @@ def check_threads(threads: int | None) -> int:
     top = numba.config.NUMBA_NUM_THREADS
     if threads is None:
         return top
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) \
-            or not 1 <= threads <= top:
+    if not is_whole(threads, 1, top):
         raise ValueError(f"threads must be an integer from 1 to {top} (NUMBA_NUM_THREADS), got "
                          f"{threads!r}")
     return int(threads)

@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import difflib
 import math
-import numbers
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
 
+from ..checks import is_finite_number, is_number, is_whole
 from ..params import (
     SECTIONS,
     ParameterError,
@@ -22,6 +23,7 @@ from ..params import (
     parameter_key,
     params_to_dict,
 )
+from ..physics.wind import MAX_WIND_SPEED
 from ..sim import INTEGRATORS
 from ..wind.presets import INTENSITY_CLASSES
 from ..wind.sizing import sized_turbulence
@@ -56,15 +58,18 @@ class TaskError(ValueError):
     """An invalid environment argument (the message names it and the value)."""
 
 
-def _range(name, value, lo_min=0.0):
-    """A (low, high) range; a single number is the fixed value (value, value)."""
-    pair = (value, value) if isinstance(value, numbers.Real) and not isinstance(value, bool) else value
+def _range(name, value, lo_min=0.0, hi_max=math.inf):
+    """A (low, high) range in [lo_min, hi_max]; a single number is the fixed value (value,
+    value)."""
+    pair = (value, value) if is_number(value) else value
     try:
         lo, hi = (float(v) for v in pair)
     except (TypeError, ValueError):
         raise TaskError(f"{name} must be a number or a (low, high) pair, got {value!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and lo_min <= lo <= hi):
-        raise TaskError(f"{name} must satisfy {lo_min} <= low <= high (finite), got {value!r}")
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo_min <= lo <= hi <= hi_max):
+        top = "" if hi_max == math.inf else f" <= {hi_max:g}"
+        raise TaskError(f"{name} must satisfy {lo_min} <= low <= high{top} (finite), got "
+                        f"{value!r}")
     return lo, hi
 
 
@@ -112,7 +117,7 @@ class TaskConfig:
 
     def __post_init__(self):
         r = self.resolved
-        r["wind_speed"] = _range("wind_speed", self.wind_speed)
+        r["wind_speed"] = _range("wind_speed", self.wind_speed, hi_max=MAX_WIND_SPEED)
         r["perturbation"] = perturbation(self.perturbation)
         if self.integrator not in INTEGRATORS:
             raise TaskError(f"unknown integrator {self.integrator!r}; choose one of {INTEGRATORS}")
@@ -129,8 +134,10 @@ class TaskConfig:
             reward.check_reward_fn(self.reward_fn)
         except ValueError as exc:
             raise TaskError(str(exc)) from None
-        if not (isinstance(self.wind_bank_size, int) and self.wind_bank_size >= 1):
+        if not is_whole(self.wind_bank_size):
             raise TaskError(f"wind_bank_size must be an integer >= 1, got {self.wind_bank_size!r}")
+        if not is_whole(self.wind_bank_seed, 0):  # the bank is part of the task: never drawn afresh
+            raise TaskError(f"wind_bank_seed must be an integer >= 0, got {self.wind_bank_seed!r}")
         r["params"] = self._params()
         try:  # the field's heights and extent follow the configured aerostat, tether and winch
             r["turbulence"] = sized_turbulence(r["params"], self.turbulence)
@@ -146,6 +153,9 @@ class TaskConfig:
             p = load_params(p)
         elif not isinstance(p, Params):
             raise TaskError(f"params must be a Params, a TOML path or None, got {type(p).__name__}")
+        if self.overrides is not None and not isinstance(self.overrides, Mapping):
+            raise TaskError("overrides must map dotted parameter names to values, e.g. "
+                            f"{{'tether.length': 300.0}}; got {self.overrides!r}")
         over = dict(self.overrides or {})
         if self.tether_length is not None:
             over["tether.length"] = self.tether_length
@@ -192,8 +202,7 @@ def turbulence_mix(spec, turb, given) -> tuple[tuple[str, ...], np.ndarray] | No
         raise TaskError(f"turbulence_mix: unknown intensity class(es) {unknown}; choose from "
                         f"{list(INTENSITY_CLASSES)}")
     for k, w in spec.items():
-        if isinstance(w, bool) or not isinstance(w, (int, float)) or not math.isfinite(w) \
-                or w < 0:
+        if not (is_finite_number(w) and w >= 0):
             raise TaskError(f"turbulence_mix[{k!r}] must be a finite weight >= 0, got {w!r}")
     total = float(sum(spec.values()))
     if total <= 0:
@@ -209,7 +218,7 @@ def _check_range_ends(params: Params, key: str, rel: float) -> None:
     """Both ends of a randomisation range must load: a range whose end is infeasible (no net
     lift, a tether length outside the winch's limits, ...) is refused when the env is made."""
     value = get_parameter(params, key)
-    if not isinstance(value, (int, float)) or isinstance(value, bool):
+    if not is_number(value):
         raise TaskError(f"randomize[{key!r}] must name a scalar number parameter, got {value!r}")
     for end in (1.0 - rel, 1.0 + rel):
         try:

@@ -8,6 +8,7 @@ seeded the same way.
 from __future__ import annotations
 
 import weakref
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -144,6 +145,14 @@ class Episode:
     info: dict
 
 
+def reset_options(options) -> dict:
+    """``reset``'s options as a dict (None: none); anything but a mapping is a TaskError."""
+    if options is not None and not isinstance(options, Mapping):
+        raise TaskError(f"reset options must be a dict such as {{'wind_speed': 10.0}}, got "
+                        f"{options!r}")
+    return dict(options or {})
+
+
 def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.random.Generator,
                    options: dict | None = None) -> Episode:
     """Draw one episode start: wind speed, parameters, trim, turbulence offset, perturbation.
@@ -151,7 +160,7 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
     ``options`` (from ``reset(options=...)``) may fix ``wind_speed`` (snapped to the 0.1 m/s
     grid) and ``perturbation`` (a preset name or dict) for this episode.
     """
-    opts = dict(options or {})
+    opts = reset_options(options)
     unknown = sorted(set(opts) - {"wind_speed", "perturbation"})
     if unknown:
         raise TaskError(f"unknown reset option(s) {unknown}; known: ['perturbation', 'wind_speed']")

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import is_whole
 from ..sim.events import RUNNING
 from .batch import EnvBatch
 
@@ -26,7 +27,7 @@ class BrakedReference:
         if batch.task.reward_fn is not None:
             raise ValueError("the braked-winch reference is the default score's return; this "
                              "environment has a custom reward_fn")
-        if not (isinstance(max_steps, (int, np.integer)) and max_steps >= 1):
+        if not is_whole(max_steps):
             raise ValueError(f"max_steps must be an integer >= 1, got {max_steps!r}")
         self.batch = batch
         self.max_steps = int(max_steps)

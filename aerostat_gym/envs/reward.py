@@ -40,11 +40,12 @@ default is a few hundred nanoseconds; a Python ``reward_fn`` costs a Python call
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import numpy as np
 from numba import njit
 
+from ..checks import is_finite_number
 from ..physics.core import FASTMATH
 from ..sim.events import FIELD_END, RUNNING
 from .spaces import OBS_DLENGTH, OBS_DPITCH, OBS_DX, OBS_DY, OBS_Q, OBS_VX, OBS_VY
@@ -84,11 +85,14 @@ LENGTH_BAND_FRACTION = 0.05
 
 def weights_vector(weights: dict | None) -> np.ndarray:
     """Reward weights in REWARD_TERMS order; unknown names or negative/non-finite values raise."""
+    if weights is not None and not isinstance(weights, Mapping):
+        raise ValueError(f"reward_weights must map reward terms {list(REWARD_TERMS)} to "
+                         f"weights, got {weights!r}")
     w = dict(DEFAULT_WEIGHTS)
     for k, v in (weights or {}).items():
         if k not in w:
             raise ValueError(f"unknown reward weight {k!r}; known: {list(REWARD_TERMS)}")
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+        if not (is_finite_number(v) and v >= 0):
             raise ValueError(f"reward weight {k!r} must be a finite number >= 0, got {v!r}")
         w[k] = float(v)
     return np.array([w[k] for k in REWARD_TERMS])

@@ -10,10 +10,11 @@ body rates p, q, r about the body x (nose), y and z axes; a positive reel speed 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from ..checks import is_finite_number
 
 
 @dataclass(frozen=True)
@@ -130,7 +131,6 @@ def check_obs_noise(value, error: type[ValueError] = ValueError) -> float:
     """A sensor-noise level (the standard deviation added to every standard channel, in scaled
     units) as a float: a finite real number >= 0, else ``error`` naming the value. One check
     for every door that takes it (the task, the LQG design, a saved residual block)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) \
-            or not (math.isfinite(value) and value >= 0):
+    if not (is_finite_number(value) and value >= 0):
         raise error(f"obs_noise must be a finite number >= 0, got {value!r}")
     return float(value)

@@ -20,11 +20,13 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from ..checks import is_number, is_whole
 from ..sim.events import FAILURES, FIELD_END, OUTCOMES, RUNNING
 from . import reward
 from .batch import EnvBatch
 from .config import TaskConfig
 from .env import frame
+from .episodes import reset_options
 from .render import Renderer
 
 DEFAULT_MAX_EPISODE_STEPS = 600
@@ -46,7 +48,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
     def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
                  render_mode: str | None = None, threads: int | None = None, **kwargs):
-        if not (isinstance(num_envs, int) and num_envs >= 1):
+        if not is_whole(num_envs):
             raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
         self.autoreset_mode = AutoresetMode(autoreset_mode)
         if render_mode not in (None, "rgb_array"):
@@ -57,11 +59,10 @@ class TetheredAerostatVectorEnv(VectorEnv):
         self.task = TaskConfig.from_kwargs(**kwargs)
         if max_episode_steps is None:
             max_episode_steps = DEFAULT_MAX_EPISODE_STEPS
-        if isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, (int, np.integer)) \
-                or max_episode_steps < 1:
+        if not is_whole(max_episode_steps):
             raise ValueError(f"max_episode_steps must be an integer >= 1, got {max_episode_steps!r}")
         self.max_episode_steps = int(max_episode_steps)
-        self.num_envs = num_envs
+        self.num_envs = int(num_envs)
         self.batch = EnvBatch(self.task, num_envs, threads)
         b = self.batch
         self.single_action_space = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
@@ -77,7 +78,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
     # --- Gymnasium VectorEnv API -----------------------------------------------------------
 
     def reset(self, *, seed=None, options=None):
-        opts = dict(options or {})
+        opts = reset_options(options)
         mask = _reset_mask(opts.pop("reset_mask", None), self.num_envs)
         seeds = _seeds(seed, self.num_envs)
         infos = []
@@ -237,7 +238,7 @@ def _stack_infos(pairs, n, prefix=""):
         for k, v in d.items():
             key = prefix + k
             if key not in out:
-                numeric = isinstance(v, (int, float, np.floating)) and not isinstance(v, bool)
+                numeric = is_number(v)
                 out[key] = np.zeros(n) if numeric else np.array([None] * n, dtype=object)
                 out["_" + key] = np.zeros(n, dtype=bool)
             out[key][i] = v

@@ -22,6 +22,7 @@ import numpy as np
 from ..analysis.modes import FIGURE9_MODES, SETS, ModalAnalysis, analyse
 from ..analysis.reference import TABLE2, TABLE2_MODES
 from ..analysis.trim import TrimError, find_equilibrium
+from ..checks import is_whole
 from ..params import ParameterError, Params
 from .cluster import start_ray, stop_ray
 from .ranges import ParameterRange
@@ -105,7 +106,7 @@ def draw_values(ranges: list[ParameterRange], n: int, seed: int) -> np.ndarray:
     n : number of parameter sets.
     seed : seed of the generator.
     """
-    if not (isinstance(n, (int, np.integer)) and n >= 1):
+    if not is_whole(n):
         raise ValueError(f"--samples must be an integer >= 1, got {n!r}")
     u = np.random.default_rng(seed).uniform(size=(n, len(ranges)))
     low = np.array([r.low for r in ranges])

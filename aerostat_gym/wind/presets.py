@@ -47,9 +47,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 from dataclasses import dataclass, field, fields
 
+from ..checks import is_finite_number
 from ..physics.wind import MIN_ADVECTION_SPEED, W_Z0, mean_speed
 from .spectra import (
     CONVENTIONS,
@@ -283,9 +283,7 @@ def _check_choice(name: str, value, choices) -> None:
 
 
 def _check_number(name: str, value, allow_zero: bool) -> None:
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
-    ok = ok and (value >= 0 if allow_zero else value > 0)
-    if not ok:
+    if not (is_finite_number(value) and (value >= 0 if allow_zero else value > 0)):
         need = ">= 0" if allow_zero else "> 0"
         raise ValueError(f"turbulence {name} must be a finite number {need}, got {value!r}")
 
