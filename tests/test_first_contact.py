@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -17,7 +18,7 @@ import tomllib
 import yaml
 
 import aerostat_gym
-from aerostat_gym.agents.train import load_hyperparams, normalize_kwargs
+from aerostat_gym.agents.train import TrainingError, load_hyperparams, normalize_kwargs, train
 from aerostat_gym.registration import TASKS
 from aerostat_gym.resources import SHIPPED_POLICY, shipped_path
 
@@ -95,6 +96,37 @@ def test_normalize_in_the_zoo_format(value, expect):
 def test_normalize_is_parsed_not_evaluated():
     with pytest.raises(ValueError, match="normalize must be"):
         normalize_kwargs({"normalize": "__import__('os').system('true')"})
+
+
+BLOCK = "TetheredAerostat-v0:\n  n_envs: 1\n  n_steps: 32\n  batch_size: 32\n"
+
+
+@pytest.mark.parametrize("text, needle", [
+    ("TetheredAerostat-v0: [1, 2\n", "not valid YAML (line 2)"),
+    ("- TetheredAerostat-v0\n", "must hold a mapping of blocks, got list"),
+    ("TetheredAerostat-v0: 5\n", "the 'TetheredAerostat-v0' block must be a mapping"),
+    (BLOCK + "aerostat_gym: 5\n", "the 'aerostat_gym' block must be a mapping"),
+    (BLOCK + "aerostat_gym:\n  env_kwargs: 3\n", "the 'aerostat_gym.env_kwargs' block must"),
+])
+def test_a_malformed_hyperparameter_file_is_named(tmp_path, text, needle):
+    path = tmp_path / "hp.yml"
+    path.write_text(text)
+    with pytest.raises(TrainingError, match=re.escape(needle)):
+        load_hyperparams("ppo", path)
+
+
+@pytest.mark.parametrize("extra, needle", [
+    ("  bogus_arg: 3\n", "PPO refuses the hyperparameters: TypeError: PPO.__init__() got an "
+                          "unexpected keyword argument 'bogus_arg'"),
+    ("  policy: NoSuchPolicy\n", "PPO refuses the hyperparameters: ValueError: Policy "
+                                  "NoSuchPolicy unknown"),
+])
+def test_a_hyperparameter_the_algorithm_refuses_is_named(tmp_path, extra, needle):
+    """SB3's own complaint, passed on as one TrainingError (not a traceback from its __init__)."""
+    path = tmp_path / "hp.yml"
+    path.write_text(BLOCK + extra)
+    with pytest.raises(TrainingError, match=re.escape(needle)):
+        train("ppo", path, timesteps=32, run_dir=tmp_path / "run", progress_bar=False)
 
 
 def test_rl_zoo3_trains_on_the_shipped_yaml(tmp_path):

@@ -110,17 +110,34 @@ def load_hyperparams(algo: str, path: str | Path | None = None) -> tuple[str, di
     path = shipped_path("hyperparams", f"{algo}.yml") if path is None else Path(path)
     if not path.is_file():
         raise TrainingError(f"hyperparameter file not found: {path}")
-    data = yaml.safe_load(path.read_text()) or {}
+    try:
+        data = yaml.safe_load(path.read_text()) or {}
+    except yaml.YAMLError as exc:
+        where = getattr(exc, "problem_mark", None)
+        line = f" (line {where.line + 1})" if where is not None else ""
+        raise TrainingError(f"{path}: not valid YAML{line}: "
+                            f"{getattr(exc, 'problem', None) or exc}") from None
+    if not isinstance(data, dict):
+        raise TrainingError(f"{path} must hold a mapping of blocks, got {type(data).__name__}")
     tasks = [k for k in data if k in TASKS]
     if len(tasks) != 1:
         raise TrainingError(f"{path} needs exactly one block keyed by a task id of "
-                            f"{sorted(TASKS)}, found {sorted(data)}")
-    project = dict(data.get(PROJECT_BLOCK) or {})
+                            f"{sorted(TASKS)}, found {sorted(map(str, data))}")
+    zoo, project = data[tasks[0]], data.get(PROJECT_BLOCK) or {}
+    _check_block(path, tasks[0], zoo)
+    _check_block(path, PROJECT_BLOCK, project)
+    _check_block(path, f"{PROJECT_BLOCK}.env_kwargs", project.get("env_kwargs") or {})
     unknown = sorted(set(project) - PROJECT_KEYS)
     if unknown:
         raise TrainingError(f"{path}: unknown key(s) {unknown} in the {PROJECT_BLOCK!r} block; "
                             f"known: {sorted(PROJECT_KEYS)}")
-    return tasks[0], dict(data[tasks[0]]), project
+    return tasks[0], dict(zoo), dict(project)
+
+
+def _check_block(path: Path, name: str, block) -> None:
+    if not isinstance(block, dict):
+        raise TrainingError(f"{path}: the {name!r} block must be a mapping of keys to values, "
+                            f"got {block!r}")
 
 
 def normalize_kwargs(hp: dict) -> dict | None:
@@ -283,7 +300,7 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
                      n_envs, timesteps)
     model = _model(algo, hp, venv, seed, run, resume,
                    actor_only=_actor_channels(venv, wrappers, base) if asymmetric else None)
-    freq = int(eval_freq or project.get("eval_freq", 50_000))
+    freq = _count("eval_freq", eval_freq or project.get("eval_freq", 50_000))
     suite_cb = suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1),
                                    run, env_kwargs.get("params"), on_eval, wrappers, base)
     write_wrappers(run / "checkpoints" / FOLDER_WRAPPERS, wrappers)
@@ -437,7 +454,17 @@ def _actor_channels(venv, wrappers: dict, base) -> list[int]:
 
 
 def _model(algo, hp, venv, seed, run, resume, actor_only=None):
-    """The SB3 model (``actor_only``: the channels of an asymmetric actor-critic's actor)."""
+    """The SB3 model (``actor_only``: the channels of an asymmetric actor-critic's actor); a
+    hyperparameter the algorithm refuses is a TrainingError naming the algorithm and its
+    message."""
+    try:
+        return _build_model(algo, hp, venv, seed, run, resume, actor_only)
+    except (TypeError, ValueError, AssertionError, KeyError) as exc:
+        raise TrainingError(f"{algo.upper()} refuses the hyperparameters: "
+                            f"{type(exc).__name__}: {exc}") from None
+
+
+def _build_model(algo, hp, venv, seed, run, resume, actor_only):
     Algo = _algorithm(algo)
     tb = _tensorboard_dir(run)
     kwargs = {k: v for k, v in hp.items() if k not in RESERVED}
