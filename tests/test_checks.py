@@ -10,13 +10,17 @@ import math
 import numpy as np
 import pytest
 
+from aerostat_gym.agents.evaluate import evaluate_policy
+from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.agents.protocol_stats import StatsInputError, iqm_ci
+from aerostat_gym.agents.sb3io import PolicyError
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.checks import is_finite_number, is_number, is_whole
 from aerostat_gym.envs.config import TaskConfig, TaskError
 from aerostat_gym.envs.env import TetheredAerostatEnv
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
 from aerostat_gym.params import ParameterError, apply_overrides, load_params
+from aerostat_gym.resources import SHIPPED_POLICY, shipped_path
 from aerostat_gym.physics.wind import MAX_WIND_SPEED
 
 
@@ -104,3 +108,23 @@ def test_the_wind_speed_ends_where_the_incompressible_model_does():
             find_equilibrium(load_params(), U)
     with pytest.raises(TaskError, match="wind_speed must satisfy 0.0 <= low <= high <= 100"):
         TaskConfig.from_kwargs(wind_speed=(5.0, 1e300))
+
+
+@pytest.mark.parametrize("make, error, message", [
+    (lambda: evaluate_policy("passive", control_step=0), TaskError,
+     r"control_step must be a number in \(0, 1\] s .* got 0"),
+    (lambda: load_policy("lqr", dt="0.2"), TaskError, "control_step must be a number"),
+    (lambda: load_policy(None), PolicyError, "a policy is a baseline's name, 'shipped' or a "
+                                             "path to a .zip, got None"),
+])
+def test_a_policy_and_its_step_are_checked_at_the_door(make, error, message):
+    with pytest.raises(error, match=message):
+        make()
+
+
+def test_a_policy_path_may_be_a_path_object():
+    """The shipped policy by pathlib.Path acts as by its name (same action on the same input)."""
+    obs = np.full((1, 19), 0.1, dtype=np.float32)
+    by_path = load_policy(shipped_path(SHIPPED_POLICY))
+    by_name = load_policy("shipped")
+    assert np.array_equal(by_path.predict(obs)[0], by_name.predict(obs)[0])

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..envs.batch import held_wind_top
-from ..envs.config import DEFAULT_WIND_RANGE
+from ..envs.config import DEFAULT_WIND_RANGE, check_control_step
 from ..envs.spaces import N_OBS
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import as_params, dumps_toml
@@ -255,7 +255,7 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     """
     sc = SCENARIOS[scenario]
     pairs = [(u, s) for u in speeds for s in seeds]
-    steps = int(round(sc.duration / control_step))
+    steps = int(round(sc.duration / check_control_step(control_step)))
     kwargs = {"wind_speed": cells_wind_range({scenario: (speeds, seeds)},
                                              (env_kwargs or {}).get("params")),
               **(env_kwargs or {}), **sc.env_kwargs}

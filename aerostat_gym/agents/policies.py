@@ -24,11 +24,13 @@ deterministic)`` signature, so one evaluator runs baselines and trained models a
 from __future__ import annotations
 
 import difflib
+import os
 from pathlib import Path
 
 import numpy as np
 
 from ..analysis.reference import reference_periods
+from ..envs.config import check_control_step
 from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION, check_obs_noise
 from ..params import Params, load_params
 from ..resources import SHIPPED_POLICY, shipped_path
@@ -135,6 +137,12 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     trained with.
     """
     params = params or load_params()
+    check_control_step(dt)  # the step the controllers are designed for
+    if isinstance(name, os.PathLike):
+        name = os.fspath(name)
+    if not isinstance(name, str):
+        raise PolicyError(f"a policy is a baseline's name, 'shipped' or a path to a .zip, got "
+                          f"{name!r}")
 
     def residual_factory(spec: dict):
         """A saved residual block validated at the door, as (base policy, command path)."""

@@ -73,9 +73,13 @@ def _range(name, value, lo_min=0.0, hi_max=math.inf):
     return lo, hi
 
 
-def _positive(name, value):
-    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-        raise TaskError(f"{name} must be a finite number > 0, got {value!r}")
+def check_control_step(value) -> float:
+    """The control step [s]: a finite number in (0, 1] (a reel command held longer than 1 s
+    cannot act on the pitch and axial-spring modes, ~3 s on the baseline)."""
+    if not (is_finite_number(value) and 0 < value <= 1.0):
+        raise TaskError(f"control_step must be a number in (0, 1] s (a reel command held "
+                        f"longer cannot act on the pitch and axial modes, ~3 s on the "
+                        f"baseline), got {value!r}")
     return float(value)
 
 
@@ -121,10 +125,7 @@ class TaskConfig:
         r["perturbation"] = perturbation(self.perturbation)
         if self.integrator not in INTEGRATORS:
             raise TaskError(f"unknown integrator {self.integrator!r}; choose one of {INTEGRATORS}")
-        dt = _positive("control_step", self.control_step)
-        if dt > 1.0:
-            raise TaskError(f"control_step must be <= 1 s (a reel command held longer cannot act "
-                            f"on the pitch and axial modes, ~3 s on the baseline), got {dt!r}")
+        check_control_step(self.control_step)
         if self.observation not in ("standard", "full"):
             raise TaskError(f"unknown observation {self.observation!r}; choose 'standard' or "
                             "'full'")
