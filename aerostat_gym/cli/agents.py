@@ -22,7 +22,14 @@ from ..envs.batch import trim_table
 from ..envs.config import TaskConfig
 from ..params import load_params
 from ..registration import TASKS
-from .common import add_config, config_label, nonneg_float, params_from_args, positive_int
+from .common import (
+    add_config,
+    config_label,
+    nonneg_float,
+    params_from_args,
+    positive_int,
+    seed_int,
+)
 
 
 def add_train_parser(sub) -> None:
@@ -35,7 +42,7 @@ def add_train_parser(sub) -> None:
     p.add_argument("--timesteps", type=positive_int,
                    help="total environment steps (default: the YAML's)")
     p.add_argument("--n-envs", type=positive_int, help="parallel environments (default: the YAML's)")
-    p.add_argument("--seed", type=int, default=0, help="training seed")
+    p.add_argument("--seed", type=seed_int, default=0, help="training seed")
     p.add_argument("--run-dir", help="output directory (default runs/train/ALGO_seedS_TIME)")
     p.add_argument("--resume", metavar="ZIP", help="checkpoint to continue from")
     p.add_argument("--eval-freq", type=positive_int,

@@ -48,6 +48,22 @@ def positive_int(text: str) -> int:
     return value
 
 
+#: the largest seed every consumer takes (SB3's set_random_seed and gymnasium reduce to 32 bits)
+MAX_SEED = 2**32 - 1
+
+
+def seed_int(text: str) -> int:
+    """argparse type: a seed, an integer from 0 to 2**32 - 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"expected a seed, an integer from 0 to 2**32 - 1, got "
+                                         f"{text!r}")
+    return value
+
+
 def positive_float(text: str) -> float:
     """argparse type: a finite number > 0."""
     value = _number(text)

@@ -16,12 +16,16 @@ from pathlib import Path
 
 import numpy as np
 
+from ..agents.train import ALGOS, load_hyperparams
+
 # the stability commands' parsing of --wind, --config and --set, shared rather than copied
 from ..scale.bench import format_throughput, throughput
+from ..scale.extra import require
 from ..scale.mc_report import summarize, write_outputs
 from ..scale.montecarlo import PERIOD_KEYS, SWEEP_SPEEDS, evaluate_sample, run_ray, run_serial
 from ..scale.ranges import RANGE_SOURCES, estimated_ranges
-from ..scale.tune import add_tune_arguments, run_tune_command
+from ..scale.tune import SCHEDULERS, SEARCHERS, SearchOptions, TrialSetup, load_space, run_search
+from .common import positive_float, positive_int, seed_int
 from .stability import parse_speeds
 from .stability import stability_params as params_from_args
 
@@ -35,13 +39,13 @@ def add_montecarlo_parser(sub) -> None:
     """
     p = sub.add_parser("montecarlo", help="Monte Carlo stability study over the estimated "
                        "parameters (Ray tasks, or --serial)")
-    p.add_argument("--samples", type=int, default=100, help="parameter sets (default 100)")
-    p.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
+    p.add_argument("--samples", type=positive_int, default=100, help="parameter sets (default 100)")
+    p.add_argument("--seed", type=seed_int, default=0, help="sampling seed (default 0)")
     p.add_argument("--serial", action="store_true", help="run in this process, without Ray")
     p.add_argument("--address", help="join this Ray cluster (e.g. auto, HOST:6379, "
                    "ray://HOST:10001) instead of starting a local one")
-    p.add_argument("--workers", type=int, help="CPUs of the local Ray instance (default: all)")
-    p.add_argument("--batch-size", type=int, help="parameter sets per Ray task")
+    p.add_argument("--workers", type=positive_int, help="CPUs of the local Ray instance (default: all)")
+    p.add_argument("--batch-size", type=positive_int, help="parameter sets per Ray task")
     p.add_argument("--wind", help="wind speeds START:STOP[:STEP] [m/s] (default 0.5:20:0.5, "
                    "the Figure 9 grid without U = 0)")
     p.add_argument("--ranges", choices=RANGE_SOURCES, default="documented",
@@ -55,7 +59,7 @@ def add_montecarlo_parser(sub) -> None:
     p.add_argument("--no-plot", action="store_true", help="skip the figure")
     p.add_argument("--bench", action="store_true", help="measure serial vs Ray throughput "
                    "and Ray start-up on --samples sets, print them, write nothing else")
-    p.add_argument("--repeats", type=int, default=3, help="--bench: alternated serial and "
+    p.add_argument("--repeats", type=positive_int, default=3, help="--bench: alternated serial and "
                    "Ray runs (default 3)")
     p.set_defaults(func=montecarlo_command)
 
@@ -170,3 +174,83 @@ def _probability_lines(s: dict) -> list[str]:
     for u in speeds:
         out.append(f"  {u:8g}" + "".join(f"{_pct(table[m][u]):>26s}" for m in shown))
     return out
+
+
+# --- tune ----------------------------------------------------------------------------------------
+
+
+def add_tune_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``aerostat-gym tune``.
+
+    Parameters
+    ----------
+    p : the tune subparser.
+    """
+    p.add_argument("--algo", choices=ALGOS, default="ppo", help="Stable-Baselines3 algorithm")
+    p.add_argument("--hyperparams", metavar="YAML",
+                   help="base hyperparameter file (default: the shipped hyperparams/ALGO.yml)")
+    p.add_argument("--space", required=True,
+                   help="search space YAML, keyed by the base file's task id")
+    p.add_argument("--seeds", type=seed_int, nargs="+", default=[0, 1, 2, 3, 4],
+                   help="training seeds; every configuration runs each (default 0-4)")
+    p.add_argument("--configs", type=positive_int, default=4, help="configurations to try (default 4)")
+    p.add_argument("--searcher", choices=SEARCHERS, default="optuna",
+                   help="how configurations are proposed (Ray Tune search algorithm)")
+    p.add_argument("--scheduler", choices=SCHEDULERS, default="fifo",
+                   help="trial scheduler (fifo: every trial runs to the end)")
+    p.add_argument("--search-seed", type=seed_int, default=0, help="seed of the sampler")
+    p.add_argument("--timesteps", type=positive_int, help="steps per trial (default: the YAML)")
+    p.add_argument("--n-envs", type=positive_int, help="environments per trial (default: the YAML)")
+    p.add_argument("--eval-freq", type=positive_int, help="steps between suite evaluations (default: "
+                   "the YAML)")
+    p.add_argument("--cpus-per-trial", type=positive_float, default=1.0,
+                   help="CPUs Ray reserves for each trial")
+    p.add_argument("--threads", type=positive_int, default=1, help="torch / numba threads per trial")
+    p.add_argument("--address", help="join this Ray cluster instead of starting a local one")
+    p.add_argument("--workers", type=positive_int, help="CPUs of the local Ray instance (default: all)")
+    p.add_argument("--out", default="runs/tune", help="output directory (default runs/tune)")
+    p.add_argument("--json", action="store_true", help="print the results as JSON")
+
+
+def setup_from_args(args: argparse.Namespace) -> TrialSetup:
+    """The shared trial setup from the command line (reads both YAML files)."""
+    task, base, project = load_hyperparams(args.algo, args.hyperparams)
+    space = load_space(args.space, task)
+    timesteps = int(args.timesteps or base.get("n_timesteps", 1e6))
+    if timesteps < 1 or args.threads < 1:
+        raise ValueError(f"--timesteps and --threads must be >= 1, got {timesteps}, {args.threads}")
+    return TrialSetup(args.algo, base, space, frozenset(), tuple(args.seeds), timesteps,
+                      args.n_envs, int(args.eval_freq or project.get("eval_freq", 50_000)),
+                      args.threads, task, project)
+
+
+def run_tune_command(args: argparse.Namespace) -> int:
+    """``aerostat-gym tune``: run the search and print the per-configuration table."""
+    require("ray.tune", "the hyperparameter search (Ray Tune)")
+    require("optuna", "the hyperparameter search (Optuna)")
+    require("stable_baselines3", "training", extra="train")
+    setup = setup_from_args(args)
+    opts = SearchOptions(args.configs, args.searcher, args.scheduler, args.search_seed,
+                         args.cpus_per_trial, args.address, args.workers)
+    res = run_search(setup, opts, Path(args.out))
+    if args.json:
+        print(json.dumps({k: res[k] for k in ("table", "best")}, indent=1))
+        return 0
+    print(format_table(res["table"]))
+    if res["best"].get("model"):
+        print(f"best checkpoint (seed {res['best']['seed']}, score {res['best']['best_score']:.3f}):"
+              f" {res['best']['model']} with {res['best']['vecnormalize']}")
+    print("wrote " + ", ".join(str(f) for f in res["files"]))
+    return 0
+
+
+def format_table(table: list[dict]) -> str:
+    """Per-configuration table as text."""
+    lines = [f"{'final score (95 % CI)':>30s} {'best score (95 % CI)':>30s} seeds  configuration"]
+    for r in table:
+        f = (f"{r['final_score_mean']:9.3f} [{r['final_score_ci95_low']:.3f}, "
+             f"{r['final_score_ci95_high']:.3f}]")
+        b = (f"{r['best_score_mean']:9.3f} [{r['best_score_ci95_low']:.3f}, "
+             f"{r['best_score_ci95_high']:.3f}]")
+        lines.append(f"{f:>30s} {b:>30s} {r['n_seeds']:5d}  {r['config']}")
+    return "\n".join(lines)

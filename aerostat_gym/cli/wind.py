@@ -30,7 +30,14 @@ from ..wind.stats import (
     target_psd,
     welch_psd,
 )
-from .common import add_config, nonneg_float, params_from_args, positive_float, positive_int
+from .common import (
+    add_config,
+    nonneg_float,
+    params_from_args,
+    positive_float,
+    positive_int,
+    seed_int,
+)
 
 
 def add_wind_parser(subparsers) -> argparse.ArgumentParser:
@@ -44,7 +51,7 @@ def add_wind_parser(subparsers) -> argparse.ArgumentParser:
                    help=f"one of {list(PRESETS)} or '{FROM_CONFIG}' "
                    "(the parameter file's wind.turbulence; default: moderate, or the file's "
                    "preset with --config)")
-    p.add_argument("--seed", type=int, default=0, help="seed of numpy.random.default_rng")
+    p.add_argument("--seed", type=seed_int, default=0, help="seed of numpy.random.default_rng")
     p.add_argument("--duration", type=positive_float, default=600.0, help="episode length [s]")
     p.add_argument("--speed", type=nonneg_float, default=8.0,
                    help="mean speed at the reference height [m/s]")

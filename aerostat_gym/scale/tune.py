@@ -24,7 +24,6 @@ configuration with its VecNormalize statistics and its hyperparameter YAML).
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import math
@@ -38,7 +37,7 @@ import numpy as np
 
 from ..agents.protocol_stats import bootstrap_mean_ci
 from ..agents.sb3io import vecnormalize_path
-from ..agents.train import ALGOS, PROJECT_BLOCK, load_hyperparams, train
+from ..agents.train import PROJECT_BLOCK, train
 from .cluster import start_ray, stop_ray
 from .extra import require
 
@@ -459,83 +458,3 @@ def _write_tables(trials: list[dict], table: list[dict], best: dict, out: Path) 
         {"table": table, "trials": trials, "best": best}, indent=1))
     files.append(out / "tune_results.json")
     return files
-
-
-# --- command line --------------------------------------------------------------------------------
-
-
-def add_tune_arguments(p: argparse.ArgumentParser) -> None:
-    """The options of ``aerostat-gym tune``.
-
-    Parameters
-    ----------
-    p : the tune subparser.
-    """
-    p.add_argument("--algo", choices=ALGOS, default="ppo", help="Stable-Baselines3 algorithm")
-    p.add_argument("--hyperparams", metavar="YAML",
-                   help="base hyperparameter file (default: the shipped hyperparams/ALGO.yml)")
-    p.add_argument("--space", required=True,
-                   help="search space YAML, keyed by the base file's task id")
-    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4],
-                   help="training seeds; every configuration runs each (default 0-4)")
-    p.add_argument("--configs", type=int, default=4, help="configurations to try (default 4)")
-    p.add_argument("--searcher", choices=SEARCHERS, default="optuna",
-                   help="how configurations are proposed (Ray Tune search algorithm)")
-    p.add_argument("--scheduler", choices=SCHEDULERS, default="fifo",
-                   help="trial scheduler (fifo: every trial runs to the end)")
-    p.add_argument("--search-seed", type=int, default=0, help="seed of the sampler")
-    p.add_argument("--timesteps", type=int, help="steps per trial (default: the YAML)")
-    p.add_argument("--n-envs", type=int, help="environments per trial (default: the YAML)")
-    p.add_argument("--eval-freq", type=int, help="steps between suite evaluations (default: "
-                   "the YAML)")
-    p.add_argument("--cpus-per-trial", type=float, default=1.0,
-                   help="CPUs Ray reserves for each trial")
-    p.add_argument("--threads", type=int, default=1, help="torch / numba threads per trial")
-    p.add_argument("--address", help="join this Ray cluster instead of starting a local one")
-    p.add_argument("--workers", type=int, help="CPUs of the local Ray instance (default: all)")
-    p.add_argument("--out", default="runs/tune", help="output directory (default runs/tune)")
-    p.add_argument("--json", action="store_true", help="print the results as JSON")
-
-
-def setup_from_args(args: argparse.Namespace) -> TrialSetup:
-    """The shared trial setup from the command line (reads both YAML files)."""
-    task, base, project = load_hyperparams(args.algo, args.hyperparams)
-    space = load_space(args.space, task)
-    timesteps = int(args.timesteps or base.get("n_timesteps", 1e6))
-    if timesteps < 1 or args.threads < 1:
-        raise ValueError(f"--timesteps and --threads must be >= 1, got {timesteps}, {args.threads}")
-    return TrialSetup(args.algo, base, space, frozenset(), tuple(args.seeds), timesteps,
-                      args.n_envs, int(args.eval_freq or project.get("eval_freq", 50_000)),
-                      args.threads, task, project)
-
-
-def run_tune_command(args: argparse.Namespace) -> int:
-    """``aerostat-gym tune``: run the search and print the per-configuration table."""
-    require("ray.tune", "the hyperparameter search (Ray Tune)")
-    require("optuna", "the hyperparameter search (Optuna)")
-    require("stable_baselines3", "training", extra="train")
-    setup = setup_from_args(args)
-    opts = SearchOptions(args.configs, args.searcher, args.scheduler, args.search_seed,
-                         args.cpus_per_trial, args.address, args.workers)
-    res = run_search(setup, opts, Path(args.out))
-    if args.json:
-        print(json.dumps({k: res[k] for k in ("table", "best")}, indent=1))
-        return 0
-    print(format_table(res["table"]))
-    if res["best"].get("model"):
-        print(f"best checkpoint (seed {res['best']['seed']}, score {res['best']['best_score']:.3f}):"
-              f" {res['best']['model']} with {res['best']['vecnormalize']}")
-    print("wrote " + ", ".join(str(f) for f in res["files"]))
-    return 0
-
-
-def format_table(table: list[dict]) -> str:
-    """Per-configuration table as text."""
-    lines = [f"{'final score (95 % CI)':>30s} {'best score (95 % CI)':>30s} seeds  configuration"]
-    for r in table:
-        f = (f"{r['final_score_mean']:9.3f} [{r['final_score_ci95_low']:.3f}, "
-             f"{r['final_score_ci95_high']:.3f}]")
-        b = (f"{r['best_score_mean']:9.3f} [{r['best_score_ci95_low']:.3f}, "
-             f"{r['best_score_ci95_high']:.3f}]")
-        lines.append(f"{f:>30s} {b:>30s} {r['n_seeds']:5d}  {r['config']}")
-    return "\n".join(lines)
