@@ -20,8 +20,8 @@ from aerostat_gym.envs.config import TaskConfig, TaskError
 from aerostat_gym.envs.env import TetheredAerostatEnv
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
 from aerostat_gym.params import ParameterError, apply_overrides, load_params
-from aerostat_gym.resources import SHIPPED_POLICY, shipped_path
 from aerostat_gym.physics.wind import MAX_WIND_SPEED
+from aerostat_gym.resources import SHIPPED_POLICY, shipped_path
 
 
 @pytest.mark.parametrize("value, number, finite, whole", [

@@ -9,6 +9,7 @@ contract of naming the field) with its tolerance.
 from __future__ import annotations
 
 import gc
+import json
 import math
 import warnings
 import weakref
@@ -493,6 +494,13 @@ def test_8_cache_holds_at_most_max_cached_banks():
     (["trim", "--config", "missing.toml"], "--config", "missing.toml"),
     (["stability", "--elements", "0"], "--elements", "0"),
     (["stability", "--wind", "5:2"], "--wind", "5:2"),
+    (["stability", "--wind", "nan:5:1"], "--wind", "nan:5:1"),
+    (["stability", "--wind", "0:100:1e-9"], "--wind", "0:100:1e-9"),
+    (["stability", "--wind", "0:150:5"], "--wind", "0:150:5"),
+    (["wind", "--speed", "1000"], "--speed", "1000"),
+    (["wind", "--duration", "1e9"], "--duration", "1e+09"),
+    (["wind", "--ensemble", "5000"], "--ensemble", "5000"),
+    (["wind", "--seed", "-1"], "--seed", "-1"),
 ])
 def test_9_bad_cli_values_are_one_line_on_stderr_with_status_2(capsys, argv, option, value):
     code, out, err = _cli(capsys, *argv)
@@ -501,6 +509,29 @@ def test_9_bad_cli_values_are_one_line_on_stderr_with_status_2(capsys, argv, opt
     line = err.strip()
     assert line.count("\n") == 0 and "Traceback" not in line
     assert option in line and value in line
+
+
+def test_9_wind_short_record_names_the_bands_it_cannot_resolve(capsys):
+    """A 30 s record at 20 m/s holds no Welch bin within +-30 % of 0.01 Hz: that band reads n/a
+    (it raised IndexError), the others are compared."""
+    code, out, err = _cli(capsys, "wind", "--speed", "20", "--duration", "30", "--json")
+    assert code == 0, err
+    coh = json.loads(out)["components"]["u"]["coherence"]["10"]
+    assert coh["freq_hz"] == [0.01, 0.03, 0.1]
+    assert math.isnan(coh["realised"][0]) and math.isnan(coh["target"][0])
+    assert all(0.0 < v <= 1.0 for v in coh["target"][1:])
+
+
+def test_9_wind_air_inertia_is_on_the_configured_hull(capsys):
+    """The air-inertia force (1 + k_i) rho V dW/dt follows the configured volume: 10 % more
+    volume in the same field (same seed, same heights) is 10 % more force."""
+    forces = []
+    for volume in (None, 1.1 * load_params().aerostat.volume):
+        extra = [] if volume is None else ["--set", f"aerostat.volume={volume!r}"]
+        code, out, err = _cli(capsys, "wind", "--duration", "60", "--json", *extra)
+        assert code == 0, err
+        forces.append(json.loads(out)["air_inertia"]["rms_axial_n"])
+    assert forces[1] / forces[0] == pytest.approx(1.1, rel=1e-9)
 
 
 def test_9_wind_input_errors_go_to_stderr(capsys):

@@ -34,7 +34,11 @@ from ..analysis.sensitivity import (
     sensitivity_table,
 )
 from ..analysis.trim import TrimLimitError, find_equilibrium, limit_warnings
+from ..physics.wind import MAX_WIND_SPEED
 from .common import add_config, params_from_args, positive_float, positive_int, warn
+
+#: the most wind speeds one sweep takes: 0.05 m/s steps over the model's whole 0-100 m/s
+MAX_SPEEDS = 2001
 
 
 def parse_speeds(text: str) -> np.ndarray:
@@ -45,19 +49,21 @@ def parse_speeds(text: str) -> np.ndarray:
         raise ValueError(f"--wind expects START:STOP[:STEP] or a speed, got {text!r}") from exc
     if len(parts) > 3:
         raise ValueError(f"--wind expects START:STOP[:STEP], got {text!r}")
-    if len(parts) == 1:
-        speeds = np.array(parts)
-    elif len(parts) in (2, 3):
-        a, b = parts[:2]
-        step = parts[2] if len(parts) == 3 else 0.5
-        if step <= 0 or b < a:
-            raise ValueError(f"--wind needs START <= STOP and STEP > 0, got {text!r}")
-        speeds = np.arange(a, b + 1e-9 * max(1.0, b), step)
-    else:
-        raise ValueError(f"--wind expects START:STOP[:STEP], got {text!r}")
-    if not np.all(np.isfinite(parts)) or np.any(speeds < 0) or speeds.size == 0:
+    if not all(math.isfinite(v) for v in parts) or min(parts[:2]) < 0:
         raise ValueError(f"--wind: wind speeds must be finite and >= 0, got {text!r}")
-    return speeds
+    if max(parts[:2]) > MAX_WIND_SPEED:
+        raise ValueError(f"--wind: wind speeds must be <= {MAX_WIND_SPEED:g} m/s (the model's "
+                         f"incompressible aerodynamics end near Mach 0.3), got {text!r}")
+    if len(parts) == 1:
+        return np.array(parts)
+    a, b = parts[:2]
+    step = parts[2] if len(parts) == 3 else 0.5
+    if step <= 0 or b < a:
+        raise ValueError(f"--wind needs START <= STOP and STEP > 0, got {text!r}")
+    if (b - a) / step + 1 > MAX_SPEEDS:
+        raise ValueError(f"--wind {text!r} asks for {(b - a) / step + 1:.3g} speeds; a sweep takes "
+                         f"at most {MAX_SPEEDS} (a longer STEP)")
+    return np.arange(a, b + 1e-9 * max(1.0, b), step)
 
 
 def stability_params(args):

@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 
 import numpy as np
 
 from ..agents.intensity import air_inertia_force
-from ..params import load_params
-from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
+from ..physics.wind import MAX_WIND_SPEED, PROFILES, W_FIELD_DT, W_TAYLOR_U
 from ..wind.field import build_wind, field_heights, field_times, mean_vector
 from ..wind.presets import INTENSITY_MODELS, METHODS, PRESETS
 from ..wind.sizing import FROM_CONFIG, sized_turbulence
@@ -73,6 +73,24 @@ def add_wind_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
+#: [s] the longest record: the standards average turbulence over 10 min to 1 h, the span over
+#: which the mean wind is taken as stationary (longer records also cost memory: a field is
+#: heights x samples x 3 doubles)
+MAX_DURATION_S = 3600.0
+#: [bytes] the most memory the pooled fields of --ensemble may take
+MAX_ENSEMBLE_BYTES = 2 * 1024**3
+
+
+def _check_record(args) -> None:
+    if args.speed > MAX_WIND_SPEED:
+        raise ValueError(f"--speed must be <= {MAX_WIND_SPEED:g} m/s (the model's incompressible "
+                         f"aerodynamics end near Mach 0.3), got {args.speed:g}")
+    if args.duration > MAX_DURATION_S:
+        raise ValueError(f"--duration must be <= {MAX_DURATION_S:g} s (turbulence statistics are "
+                         f"stationary over 10 min to 1 h; pool seeds with --ensemble for more), "
+                         f"got {args.duration:g}")
+
+
 def _config(args, params):
     """Preset with the command-line overrides, its field grid sized from the configuration
     (errors are ValueError with a clear message)."""
@@ -89,10 +107,9 @@ def _config(args, params):
 def wind_command(args) -> int:
     """Run ``aerostat-gym wind``; returns the exit status (2 on invalid input)."""
     try:
+        _check_record(args)
         params = params_from_args(args)
         cfg = _config(args, params)
-        if args.ensemble < 1:
-            raise ValueError(f"--ensemble must be >= 1, got {args.ensemble}")
         w = params.wind
         mean = {"profile": args.profile or w.profile, "speed": args.speed,
                 "reference_height": args.reference_height or w.reference_height,
@@ -101,6 +118,10 @@ def wind_command(args) -> int:
         t0 = time.perf_counter()
         wp, wf = build_wind(mean, cfg, args.duration, np.random.default_rng(args.seed))
         gen_s = time.perf_counter() - t0
+        if wf.nbytes * args.ensemble > MAX_ENSEMBLE_BYTES:
+            raise ValueError(f"--ensemble {args.ensemble} x {args.duration:g} s would hold "
+                             f"{wf.nbytes * args.ensemble / 1024**3:.1f} GiB of fields (at most "
+                             f"{MAX_ENSEMBLE_BYTES / 1024**3:g}): fewer seeds or a shorter record")
         fields = [wf] + [build_wind(mean, cfg, args.duration, np.random.default_rng(s))[1]
                          for s in range(args.seed + 1, args.seed + args.ensemble)]
     except (ValueError, TypeError) as e:
@@ -113,19 +134,19 @@ def wind_command(args) -> int:
     cfg = cfg.for_wind(mean_vector(mean))  # the class's sigmas in this mean wind
     if not cfg.is_off:
         out.update(realised_statistics(cfg, wp, fields))
-        out["air_inertia"] = _air_inertia(cfg, wp, wf, args.duration)
+        out["air_inertia"] = _air_inertia(params, cfg, wp, wf, args.duration)
     print(json.dumps(out, indent=2) if args.json else _table(out))
     if args.plot and not cfg.is_off:
         _plot(args.plot, cfg, wp, fields)
     return 0
 
 
-def _air_inertia(cfg, wp, wf, duration: float) -> dict:
-    """Air-inertia force on the baseline hull held at the field's reference height."""
-    p = load_params()
-    a = p.aerostat
+def _air_inertia(params, cfg, wp, wf, duration: float) -> dict:
+    """Air-inertia force on the configured hull held at the field's reference height."""
+    a = params.aerostat
     return air_inertia_force(wp, wf, (0.0, 0.0, cfg.reference_height),
-                             p.environment.rho_air * a.volume, a.k1, a.k3, a.length, duration)
+                             params.environment.rho_air * a.volume, a.k1, a.k3, a.length,
+                             duration)
 
 
 def _table(out: dict) -> str:
@@ -143,17 +164,25 @@ def _table(out: dict) -> str:
                      f"{c['integral_length']:12.1f}{c['integral_length_target']:10.1f}"
                      f"{c['integral_length_acf']:16.1f}")
     ai = out["air_inertia"]
-    lines.append(f"air inertia on the baseline hull held at {out['height']:.0f} m ((1 + k_i) rho V "
+    lines.append(f"air inertia on the configured hull held at {out['height']:.0f} m ((1 + k_i) rho V "
                  f"dW_i/dt): RMS axial {ai['rms_axial_n']:.0f} N, lateral {ai['rms_lateral_n']:.0f} N, "
                  f"vertical {ai['rms_vertical_n']:.0f} N, peak |F| {ai['peak_n']:.0f} N "
                  f"(RMS |dW/dt| {ai['rms_air_acceleration_m_s2']:.3f} m/s^2)")
-    lines.append("coherence realised/target (IEC), band-averaged around f:")
+    lines.append("coherence realised/target (IEC), band-averaged around f (n/a: the record is too short for the band):")
     for name, c in out["components"].items():
         for r, d in c["coherence"].items():
-            cells = "  ".join(f"{f:g} Hz {g:.2f}/{w:.2f}" for f, g, w in
+            cells = "  ".join(f"{f:g} Hz {_pair(g, w)}" for f, g, w in
                               zip(d["freq_hz"], d["realised"], d["target"], strict=True))
             lines.append(f"  {name} r = {r:>3} m: {cells}")
     return "\n".join(lines)
+
+
+def _pair(realised: float, target: float) -> str:
+    """'realised/target' to two decimals; n/a where the record cannot resolve the band (both
+    NaN) or the field has no row that far below (realised NaN)."""
+    if math.isnan(target):
+        return "n/a"
+    return ("n/a" if math.isnan(realised) else f"{realised:.2f}") + f"/{target:.2f}"
 
 
 def _plot(path: str, cfg, wp, fields) -> None:

@@ -249,6 +249,10 @@ def _coherence_at(cfg, x, k0, r, dt, U, c, freqs) -> dict:
         fb, P = welch_psd(x[:, k0], dt, nperseg=min(x.shape[-1], 2048))
         S, T = target_psd(cfg, U, c, fb), target_coherence(cfg, U, c, fb, r)
         _, (num, den) = band_sums(fb, [S * T, S], edges)
+        if num.size == 0:  # the record is too short to resolve this band: nothing to compare
+            want.append(float("nan"))
+            got.append(float("nan"))
+            continue
         want.append(float(num[0] / den[0]))
         if nz == 1:  # single-point (filter) field: the same series at every height
             got.append(1.0)
