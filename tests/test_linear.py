@@ -481,3 +481,20 @@ def test_mode_rows_are_json(sweep):
     assert json.loads(text) == rows
     expected = sum(m is not None for s in ("long", "lat") for _, t in sweep.tracks[s] for m in t)
     assert len(rows) == expected > 0
+
+
+def test_sensitivity_names_an_end_without_trim_instead_of_calling_it_unstable(base):
+    """A nearly neutral aerostat (mass 580 kg: 150 N of net lift) with its CM 0.3 m forward
+    has no trim by 2.9 m/s: that end reads NO TRIM with its cells n/a and its error in the
+    table, and the row is not called UNSTABLE (its other end is stable everywhere)."""
+    from aerostat_gym.analysis.sensitivity import format_sensitivity, sensitivity_table
+
+    light = base.replace(**{"aerostat.mass": 580.0})
+    knob = [k for k in default_knobs(light) if k.key == "cm_x_shift"]
+    tab = sensitivity_table(light, knob)
+    row = tab["rows"][0]
+    assert "no equilibrium found" in row["high_result"]["error"]
+    assert row["low_result"]["all_stable"] and "high_pct" not in row
+    line = [s for s in format_sensitivity(tab).splitlines() if s.startswith(row["label"])][0]
+    assert line.endswith("NO TRIM (high)") and "UNSTABLE" not in line
+    assert "nan" not in line and line.count("n/a") == 5

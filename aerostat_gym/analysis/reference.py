@@ -266,10 +266,12 @@ def nearest_closed_form(key: str, linear: float, closed: dict) -> tuple[str, flo
 
 
 def is_paper_case(params: Params) -> bool:
-    """True when the aerostat, tether and air are the shipped [LN02] baseline's (the paper's
-    Table 2 columns and bands then apply)."""
+    """True when the aerostat, tether and air are the shipped [LN02] baseline's and the mean
+    wind is uniform, as in [LN02] (the paper's Table 2 columns and bands then apply; under a
+    sheared profile the wind at the aerostat is not the reference speed)."""
     base = load_params()
-    return all(getattr(params, s) == getattr(base, s) for s in PAPER_SECTIONS)
+    return (params.wind.profile == "uniform"
+            and all(getattr(params, s) == getattr(base, s) for s in PAPER_SECTIONS))
 
 
 def table2(params: Params | None = None, wind_speed: float = TABLE2_WIND,

@@ -263,13 +263,31 @@ def format_sensitivity(table: dict) -> str:
         cells = []
         for k in PERIOD_KEYS:
             lo, hi = r.get("low_pct", {}).get(k, math.nan), r.get("high_pct", {}).get(k, math.nan)
-            cells.append(f"{lo:+6.1f}/{hi:+6.1f}")
-        zl = r["low_result"].get("min_zeta", math.nan)
-        zh = r["high_result"].get("min_zeta", math.nan)
-        flag = "" if r["low_result"].get("all_stable", False) and r["high_result"].get("all_stable", False) else " UNSTABLE"
+            cells.append(f"{_signed(lo)}/{_signed(hi)}")
+        ends = (r["low_result"], r["high_result"])
+        zl, zh = (_plain(e.get("min_zeta", math.nan)) for e in ends)
         lines.append(f"{r['label']:32s} {r['low']:8.4g}-{r['high']:<8.4g} " + " ".join(f"{c:>13s}" for c in cells)
-                     + f" {zl:6.3f}/{zh:6.3f}{flag}")
+                     + f" {zl}/{zh}{_verdict(ends)}")
+    if any("n/a" in line for line in lines):
+        lines.append("n/a: no trim at that end, or no mode of that name (--json has the errors)")
     return "\n".join(lines)
+
+
+def _signed(x: float) -> str:
+    return "   n/a" if math.isnan(x) else f"{x:+6.1f}"
+
+
+def _plain(x: float) -> str:
+    return "   n/a" if math.isnan(x) else f"{x:6.3f}"
+
+
+def _verdict(ends) -> str:
+    """' UNSTABLE' where an end's sweep found an unstable mode, ' NO TRIM (low/high)' where an
+    end has no trim to judge; nothing when both ends are stable everywhere."""
+    failed = [name for name, e in zip(("low", "high"), ends, strict=True) if "error" in e]
+    if failed:
+        return f" NO TRIM ({'/'.join(failed)})"
+    return "" if all(e.get("all_stable", False) for e in ends) else " UNSTABLE"
 
 
 def solve_for_period(params: Params, knob: Knob, target: float, key: str = "lat_pendulum",
