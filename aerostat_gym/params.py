@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from .checks import is_number, is_whole
+from .checks import is_finite_number, is_number, is_whole
 
 try:  # Python >= 3.11
     import tomllib
@@ -273,8 +273,10 @@ def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
         return value
     if check == INT_GE1:
         if not is_whole(value, 1, MAX_ELEMENTS):
+            typed = " (write it without a decimal point)" if (
+                is_finite_number(value) and value == int(value) and 1 <= value <= MAX_ELEMENTS) else ""
             raise ParameterError(f"{name} must be an integer >= 1 and <= {MAX_ELEMENTS}, got "
-                                 f"{value!r}")
+                                 f"{value!r}{typed}")
         return int(value)
     if not is_number(value):
         raise ParameterError(f"{name} must be a number, got {value!r}")
@@ -535,7 +537,13 @@ def _config_text(path: str | Path | None) -> tuple[str, str]:
     if not path.is_file():
         raise ParameterError(f"parameter file not found: {path} (shipped configurations: "
                              f"{', '.join(shipped_configs())})")
-    return path.read_text(), str(path)
+    try:  # TOML is UTF-8 by its specification, whatever the machine's locale
+        return path.read_bytes().decode("utf-8"), str(path)
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{path}: not UTF-8 text (TOML files are UTF-8): byte "
+                             f"{exc.object[exc.start]:#04x} at offset {exc.start}") from None
+    except OSError as exc:
+        raise ParameterError(f"{path}: cannot be read: {exc.strerror}") from None
 
 
 def load_params(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Params:

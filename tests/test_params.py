@@ -69,6 +69,7 @@ def test_round_trip_through_toml(base):
         ("environment.rho_air", 0.0, "environment.rho_air must be > 0"),
         ("tether.n_elements", 0, "tether.n_elements must be an integer >= 1"),
         ("tether.n_elements", 2.5, "tether.n_elements must be an integer >= 1"),
+        ("tether.n_elements", 6.0, r"got 6.0 \(write it without a decimal point\)"),
         ("tether.damping_ratio", -0.1, "tether.damping_ratio must be >= 0"),
         ("fins.alpha_stall_deg", 90.0, r"fins.alpha_stall_deg must lie in \(0, 90\)"),
         ("fins.alpha_stall_deg", 0.0, r"fins.alpha_stall_deg must lie in \(0, 90\)"),
@@ -149,3 +150,12 @@ def test_packed_offsets_match_field_table():
         assert getattr(layout, "P_" + name) == off, name
         off += size
     assert layout.P_SIZE == off
+
+
+def test_a_file_that_is_not_utf8_is_named(tmp_path):
+    """TOML is UTF-8: a Latin-1 comment is refused with the file, the byte and its offset (a
+    bare UnicodeDecodeError named neither)."""
+    path = tmp_path / "latin1.toml"
+    path.write_bytes("# caf\u00e9\n".encode("latin-1"))
+    with pytest.raises(ParameterError, match=rf"{path.name}: not UTF-8 text .* byte 0xe9 at offset 5"):
+        load_params(path)

@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
+from pathlib import Path
 
 from .. import __version__
 from ..params import ParameterError
 from .agents import add_agent_parsers
-from .common import OneLineParser
+from .common import OneLineParser, warn
 from .model import add_model_parsers
 from .scale import add_montecarlo_parser, add_tune_parser
 from .stability import add_stability_parsers
@@ -63,13 +65,36 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+PACKAGE_DIR = str(Path(__file__).resolve().parents[1])
+
+
+def one_line_warnings(command: str):
+    """A ``warnings.showwarning`` that prints the package's own warnings as one line, like its
+    errors (``aerostat-gym COMMAND: warning: ...``), each text once (the same condition is often
+    found by two layers, e.g. a command's check and the environment it builds), and others as
+    Python does."""
+    default, said = warnings.showwarning, set()
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if str(Path(filename).resolve()).startswith(PACKAGE_DIR):
+            if str(message) not in said:
+                said.add(str(message))
+                warn(command, str(message))
+        else:
+            default(message, category, filename, lineno, file, line)
+
+    return show
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    try:
-        return args.func(args)
-    except (ParameterError, ValueError, RuntimeError, OSError) as exc:
-        print(f"aerostat-gym {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+    with warnings.catch_warnings():
+        warnings.showwarning = one_line_warnings(args.command)
+        try:
+            return args.func(args)
+        except (ParameterError, ValueError, RuntimeError, OSError) as exc:
+            print(f"aerostat-gym {args.command}: error: {exc}", file=sys.stderr)
+            return 2
 
 
 if __name__ == "__main__":

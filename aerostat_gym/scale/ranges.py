@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 from ..analysis.sensitivity import default_knobs
 from ..envs.config import DEFAULT_RANDOMIZATION
-from ..params import Params, apply_overrides
+from ..params import Params, apply_overrides, load_params
 
 RANGE_SOURCES = ("documented", "randomization")
 
@@ -85,17 +85,18 @@ def estimated_ranges(params: Params, source: str = "documented") -> list[Paramet
     raise ValueError(f"unknown range source {source!r}; choose one of {RANGE_SOURCES}")
 
 
-def range_disagreements(params: Params) -> list[dict]:
+def range_disagreements(params: Params | None = None) -> list[dict]:
     """Parameters present in both tables whose ranges differ by more than 1 % of the nominal.
 
     Parameters
     ----------
-    params : base parameter set.
+    params : base parameter set (default: the baseline).
 
     Returns
     -------
     one dict per parameter: key, nominal, documented (low, high), randomization (low, high).
     """
+    params = params or load_params()
     documented = {r.key: r for r in _documented(params)}
     rows = []
     for r in _randomization(params):
