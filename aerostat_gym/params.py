@@ -45,8 +45,9 @@ class ParameterWarning(UserWarning):
 
 # --- field helpers -----------------------------------------------------------------------------
 
-POSITIVE, NONNEG, ANY, INT_GE1, STALL, VEC3, COEFFS, BOOL = (
-    "positive", "nonneg", "any", "int>=1", "stall", "vec3", "coeffs", "bool",
+POSITIVE, NONNEG, ANY, INT_GE1, STALL, VEC3, COEFFS, BOOL, FRACTION, EFFICIENCY = (
+    "positive", "nonneg", "any", "int>=1", "stall", "vec3", "coeffs", "bool", "fraction",
+    "efficiency",
 )
 
 
@@ -89,8 +90,10 @@ class AerostatParams:
     nose_position: tuple = _f("m", "CALIB", VEC3, "nose relative to the CM (body); z = hull axis")
     leash_z: float = _f("m", "SOURCED", ANY, "confluence point height relative to the CM (1.5 D below axis)")
     trim_pitch_deg: float = _f("deg", "SOURCED", ANY, "zero-wind trim pitch (negative = nose up)")
-    k1: float = _f("-", "ESTIMATE", NONNEG, "axial added-mass coefficient")
-    k3: float = _f("-", "ESTIMATE", NONNEG, "lateral added-mass coefficient (y and z)")
+    # Lamb's coefficients of a body of revolution lie in [0, 1]: 0.5 for a sphere, k1 -> 0 and
+    # k3 -> 1 as the fineness ratio grows
+    k1: float = _f("-", "ESTIMATE", FRACTION, "axial added-mass coefficient")
+    k3: float = _f("-", "ESTIMATE", FRACTION, "lateral added-mass coefficient (y and z)")
     air_inertia: bool = _f("-", "ESTIMATE", BOOL, "Froude-Krylov plus added-mass force "
                            "(1 + k_i) rho V dW_i/dt of accelerating air on the hull (Morison's "
                            "inertia term, local dW/dt averaged over the hull length; an upper "
@@ -113,7 +116,8 @@ class HullParams:
     J2: float = _f("m^3", "ESTIMATE", ANY, "first moment of J1 about the nose")
     CD0: float = _f("-", "ESTIMATE", NONNEG, "zero-alpha axial drag coefficient on V^(2/3)")
     Cdc: float = _f("-", "ESTIMATE", NONNEG, "cross-flow drag coefficient on J1")
-    eta_k: float = _f("-", "CALIB", NONNEG, "hull efficiency factor")
+    eta_k: float = _f("-", "CALIB", FRACTION, "hull efficiency factor (a fraction of the "
+                      "slender-body lift)")
 
 
 @dataclass(frozen=True)
@@ -134,7 +138,7 @@ class FinParams:
     post_stall: str = _f("-", "SOURCED", ANY, "beyond stall: 'viterna' (Viterna-Corrigan normal "
                          "force to C_D,max at 90 deg) or 'flat' ([LN02]'s C_L held flat)")
     CD0: float = _f("-", "ESTIMATE", NONNEG, "parasite drag coefficient")
-    oswald_e: float = _f("-", "ESTIMATE", POSITIVE, "Oswald efficiency")
+    oswald_e: float = _f("-", "ESTIMATE", EFFICIENCY, "Oswald efficiency (1: elliptic loading)")
     panels: tuple = _f("-", "SOURCED", ANY, "fin panels (inverted Y: upper, port, starboard)")
 
 
@@ -289,6 +293,10 @@ def _check_value(name: str, value: Any, f: dataclasses.Field) -> Any:
         raise ParameterError(f"{name} must be >= 0, got {value!r}")
     if check == STALL and not 0 < value < 90:
         raise ParameterError(f"{name} must lie in (0, 90) deg, got {value!r}")
+    if check == FRACTION and not 0 <= value <= 1:
+        raise ParameterError(f"{name} must lie in [0, 1], got {value!r}")
+    if check == EFFICIENCY and not 0 < value <= 1:
+        raise ParameterError(f"{name} must lie in (0, 1], got {value!r}")
     return value
 
 
@@ -334,6 +342,9 @@ def _cross_checks(p: Params) -> None:
             f"winch.min_length ({p.winch.min_length}) must be < winch.max_length ({p.winch.max_length})"
         )
     check_length_within_winch(p)
+    if p.hull.l_h > p.aerostat.length:
+        raise ParameterError(f"hull.l_h = {p.hull.l_h} m (nose to the fins' root) must not exceed "
+                             f"aerostat.length = {p.aerostat.length} m")
     if not -89.0 < p.aerostat.trim_pitch_deg < 89.0:
         raise ParameterError(f"aerostat.trim_pitch_deg must lie in (-89, 89), got {p.aerostat.trim_pitch_deg}")
     d = Derived.from_params(p)
@@ -434,6 +445,26 @@ def _advise(p: Params, source: str) -> None:
             f"at 34 ms). Set simulation.semi_implicit_dt <= {advised:.3g}, or use "
             "integrator='rk4'",
             ParameterWarning, stacklevel=3)
+    for text in hull_integral_warnings(p):
+        warnings.warn(f"{source}: {text}: check the hull integrals (docs/parameters.md, "
+                      "section 1c)", ParameterWarning, stacklevel=3)
+
+
+def hull_integral_warnings(p: Params) -> list[str]:
+    """What the Jones-DeLaurier integrals of the hull region (nose to l_h) say that no hull can
+    have: V_h = l_h I1 - I3, the volume ahead of l_h, outside [0, aerostat.volume], or the
+    centroid J2 / J1 of the side area outside [0, l_h]."""
+    h, volume = p.hull, p.aerostat.volume
+    out = []
+    v_h = h.l_h * h.I1 - h.I3
+    if not 0.0 <= v_h <= volume:
+        out.append(f"hull.I3 = {h.I3:g} m^3 with hull.l_h = {h.l_h:g} m and hull.I1 = {h.I1:g} "
+                   f"m^2 puts {v_h:.4g} m^3 of hull ahead of l_h (V_h = l_h I1 - I3), outside "
+                   f"[0, aerostat.volume = {volume:g}]")
+    if h.J1 > 0.0 and not 0.0 <= h.J2 / h.J1 <= h.l_h:
+        out.append(f"hull.J2 / hull.J1 = {h.J2 / h.J1:.4g} m, the centroid of the hull's side "
+                   f"area, lies outside the hull region [0, hull.l_h = {h.l_h:g}] m")
+    return out
 
 
 def check_length_within_winch(p: Params) -> None:

@@ -6,6 +6,7 @@ import pytest
 
 from aerostat_gym.params import (
     ParameterError,
+    ParameterWarning,
     dumps_toml,
     load_params,
     parameter_table,
@@ -73,6 +74,12 @@ def test_round_trip_through_toml(base):
         ("tether.damping_ratio", -0.1, "tether.damping_ratio must be >= 0"),
         ("fins.alpha_stall_deg", 90.0, r"fins.alpha_stall_deg must lie in \(0, 90\)"),
         ("fins.alpha_stall_deg", 0.0, r"fins.alpha_stall_deg must lie in \(0, 90\)"),
+        ("aerostat.k1", 50.0, r"aerostat.k1 must lie in \[0, 1\], got 50.0"),
+        ("aerostat.k3", -0.1, r"aerostat.k3 must lie in \[0, 1\]"),
+        ("hull.eta_k", 5.0, r"hull.eta_k must lie in \[0, 1\]"),
+        ("fins.oswald_e", 1.2, r"fins.oswald_e must lie in \(0, 1\]"),
+        ("fins.oswald_e", 0.0, r"fins.oswald_e must lie in \(0, 1\]"),
+        ("hull.l_h", 500.0, r"hull.l_h = 500.0 m .* must not exceed aerostat.length = 18.3 m"),
         ("tether.length", "long", "tether.length must be a number"),
         ("tether.length", float("nan"), "tether.length must be finite"),
         ("wind.profile", "cubic", "wind.profile must be one of"),
@@ -159,3 +166,22 @@ def test_a_file_that_is_not_utf8_is_named(tmp_path):
     path.write_bytes("# caf\u00e9\n".encode("latin-1"))
     with pytest.raises(ParameterError, match=rf"{path.name}: not UTF-8 text .* byte 0xe9 at offset 5"):
         load_params(path)
+
+
+@pytest.mark.parametrize("key, value, message", [
+    # V_h = 12 x 33.45 - 500 = -98.6 m^3: a negative volume ahead of the fins
+    ("hull.I3", 500.0, r"puts -98.6 m\^3 of hull ahead of l_h .* outside \[0, aerostat.volume = 519\]"),
+    # V_h = 401.4 + 300 = 701.4 m^3 > 519 m^3
+    ("hull.I3", -300.0, r"puts 701.4 m\^3 of hull ahead of l_h"),
+    # centroid 514.9 / 30 = 17.2 m, beyond l_h = 12 m
+    ("hull.J1", 30.0, r"hull.J2 / hull.J1 = 17.16 m, the centroid .* outside the hull region"),
+])
+def test_hull_integrals_no_hull_can_have_warn_at_the_door(tmp_path, base, key, value, message):
+    """The Jones-DeLaurier integrals are estimates, so an impossible set warns (naming the
+    file, the fields and the volume or centroid they imply) rather than refusing; the shipped
+    files are consistent (V_h = 424 m^3 of the baseline's 519, centroid 6.6 m of 12 m)."""
+    path = tmp_path / "hull.toml"
+    path.write_text(dumps_toml(base.replace(**{key: value})))
+    with pytest.warns(ParameterWarning, match=message):
+        load_params(path)
+    assert base.hull.l_h * base.hull.I1 - base.hull.I3 == pytest.approx(424.13, abs=0.01)
