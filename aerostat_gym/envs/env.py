@@ -227,6 +227,12 @@ class TetheredAerostatEnv(gym.Env):
       wind range's trims are judged by the tether's largest tension (was the winch end); the
       vector env supports ``autoreset_mode=AutoresetMode.DISABLED``, checks ``reset_mask`` and
       refuses a ``max_episode_steps`` below 1 (0 meant 600, a negative one truncated every step).
+    - v0 (aerostat-gym 0.7.7; dynamics, observation and reward unchanged): the doors read
+      numbers by one rule (a bool is never a count, a NumPy integer is one: ``num_envs=
+      np.int64(4)`` is accepted, ``num_envs=True`` refused); ``wind_bank_seed`` must be an
+      integer >= 0 (a NumPy TypeError before); ``overrides``, ``reward_weights`` and the reset
+      options must be mappings (TypeErrors before); ``wind_speed`` is capped at 100 m/s, where
+      the incompressible aerodynamics end (1e300 hung the trim table).
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
