@@ -440,6 +440,9 @@ def test_full_sensitivity_table(base):
     assert all("low_pct" in r and "high_pct" in r for r in rows.values())
     top = [r["knob"] for r in tab["rows"][:5]]
     assert {"hull.eta_k", "fins.CL_alpha", "fins.planform_area"} <= set(top)
+    # eta_k = 0.5 overdamps the lateral pendulum at 1 m/s (a real root, 2 pi / |lambda| = 184 s,
+    # once printed as a period): no period, and the row ranks first
+    assert math.isnan(rows["hull.eta_k"]["high_pct"]["lat_pendulum"]) and top[0] == "hull.eta_k"
     for key in ("aerostat.Ixx", "aerostat.Ixz", "tether.Cd_normal"):
         assert rows[key]["max_abs_pct"] < 1.0
 

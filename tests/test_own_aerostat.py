@@ -170,6 +170,25 @@ def test_table2_against_own_closed_forms(case, capsys):
     _no_baseline_numbers(name, text)
 
 
+def test_table2_reads_an_overdamped_mode_as_real_like_stability(capsys):
+    """0.003x the baseline on 1053 m trimmed 12 deg nose down: at 1 m/s the longitudinal
+    pendulum and the first harmonic are real eigenvalues (stability: 'real (1.000)'); table2
+    says 'real' with n/a differences (it printed 2 pi / |lambda|, 225 s and 1.02 s, as
+    periods), and its still-air column still matches the closed form."""
+    p = scale_aerostat(load_params(), 0.003, 1053.0, 29, 12.0)
+    rows = {r["key"]: r for r in table2(p)}
+    sweep = analyse(p, find_equilibrium(p, 1.0))
+    for key in ("long_pendulum", "tether_1st"):
+        assert rows[key]["linear_overdamped"] and math.isnan(rows[key]["linear_s"])
+        assert math.isnan(rows[key]["diff_pct"]) and rows[key]["within_tolerance"]
+    assert not sweep.find("long", "pendulum").oscillatory
+    assert rows["axial_spring"]["linear_s"] == pytest.approx(
+        sweep.find("long", "axial spring").period, rel=1e-12)
+    line = [s for s in format_table2(list(rows.values())).splitlines()
+            if s.startswith("Long. pendulum")][0]
+    assert line.split("|")[1].split()[1:] == ["real", "n/a", "n/a"]
+
+
 def test_table2_under_a_sheared_wind_is_not_the_papers_case():
     """[LN02]'s wind is uniform: the baseline aerostat under a power-law profile gets no paper
     columns (its 'U = 1' is not 1 m/s at the aerostat, and the paper's band would read MISS),

@@ -134,12 +134,20 @@ def pct_diff(value: float, reference: float) -> float:
 
 
 def linear_table2_periods(analysis) -> dict:
-    """Periods of the Table 2 modes in a :class:`~aerostat_gym.analysis.modes.ModalAnalysis`."""
+    """Periods of the Table 2 modes in a :class:`~aerostat_gym.analysis.modes.ModalAnalysis`;
+    NaN for a mode that is absent or overdamped (a real eigenvalue oscillates at no period:
+    2 pi / |lambda| would read as one, as 'stability' shows 'real' for it)."""
     out = {}
     for key, (subset, label) in TABLE2_MODES.items():
         mode = analysis.find(subset, label)
-        out[key] = mode.period if mode is not None else math.nan
+        out[key] = mode.period if mode is not None and mode.oscillatory else math.nan
     return out
+
+
+def overdamped_table2_modes(analysis) -> set:
+    """The Table 2 modes present in ``analysis`` as real (overdamped) eigenvalues."""
+    return {key for key, (subset, label) in TABLE2_MODES.items()
+            if (mode := analysis.find(subset, label)) is not None and not mode.oscillatory}
 
 
 #: Wind speed of the still-air column [m/s]: the trim and the linearization need a wind to
@@ -295,9 +303,11 @@ def table2(params: Params | None = None, wind_speed: float = TABLE2_WIND,
     p = params or load_params()
     theory = reference_periods(p)
     closed = closed_form_periods(p)
-    linear = linear_table2_periods(analyse(p, find_equilibrium(p, wind_speed)))
+    windy = analyse(p, find_equilibrium(p, wind_speed))
+    linear, overdamped = linear_table2_periods(windy), overdamped_table2_modes(windy)
     calm_analysis = analyse(p, find_equilibrium(p, calm_speed))
-    calm = linear_table2_periods(calm_analysis)
+    calm, calm_overdamped = (linear_table2_periods(calm_analysis),
+                             overdamped_table2_modes(calm_analysis))
     paper_case = is_paper_case(p)
     rows = []
     for key, paper in TABLE2.items():
@@ -307,6 +317,7 @@ def table2(params: Params | None = None, wind_speed: float = TABLE2_WIND,
                "diff_pct": pct_diff(linear[key], theory[key]), "closed_form_s": target,
                "closed_form_mode": named, "calm_linear_s": calm[key], "calm_diff_pct": diff,
                "wind_effect_pct": pct_diff(linear[key], nearest_closed_form(key, linear[key], closed)[1]),
+               "linear_overdamped": key in overdamped, "calm_overdamped": key in calm_overdamped,
                "tolerance_pct": THEORY_TOLERANCE_PCT[key],
                "within_tolerance": bool(abs(diff) <= THEORY_TOLERANCE_PCT[key]),
                "paper_case": paper_case}
@@ -333,9 +344,15 @@ def veering_allowance(key: str, closed: float, linear: float, diff: float, analy
             "within_tolerance": bool(abs(diff) <= VEERING_TOLERANCE_PCT)}
 
 
-def _seconds(period: float, width: int) -> str:
-    """A period as 'NN.NNNs' right-aligned in ``width``, or 'not found' for a missing mode."""
-    text = "not found" if math.isnan(period) else f"{period:.3f}s"
+def _seconds(period: float, width: int, overdamped: bool = False) -> str:
+    """A period as 'NN.NNNs' right-aligned in ``width``; 'real' for an overdamped mode, 'not
+    found' for a missing one."""
+    text = "real" if overdamped else "not found" if math.isnan(period) else f"{period:.3f}s"
+    return f"{text:>{width}s}"
+
+
+def _pct(value: float, width: int, decimals: int) -> str:
+    text = "n/a" if math.isnan(value) else f"{value:+.{decimals}f}"
     return f"{text:>{width}s}"
 
 
@@ -358,9 +375,10 @@ def format_table2(rows: list[dict], wind_speed: float = TABLE2_WIND,
              "-" * len(head)]
     for r in rows:
         flag = f"{r['tolerance_pct']:3.0f}% " + ("ok" if r["within_tolerance"] else "MISS")
-        line = (f"{r['mode']:22s} {r['closed_form_s']:8.3f}s {_seconds(r['calm_linear_s'], 14)} "
-                f"{r['calm_diff_pct']:+7.2f} {flag:>10s} | {r['theory_s']:9.2f}s "
-                f"{_seconds(r['linear_s'], 10)} {r['diff_pct']:+7.1f} {r['wind_effect_pct']:+7.1f}")
+        line = (f"{r['mode']:22s} {r['closed_form_s']:8.3f}s {_seconds(r['calm_linear_s'], 14, r['calm_overdamped'])} "
+                f"{_pct(r['calm_diff_pct'], 7, 2)} {flag:>10s} | {r['theory_s']:9.2f}s "
+                f"{_seconds(r['linear_s'], 10, r['linear_overdamped'])} "
+                f"{_pct(r['diff_pct'], 7, 1)} {_pct(r['wind_effect_pct'], 7, 1)}")
         if paper:
             pflag = "ok" if r["within_paper_band"] else "MISS"
             line += (f" | {r['paper_theory_s']:11.2f}s {r['paper_linear_s']:11.2f}s "
@@ -370,7 +388,7 @@ def format_table2(rows: list[dict], wind_speed: float = TABLE2_WIND,
             line += f"  (veers with {r['veers_with']}, {r['veering_partner_s']:.3f}s)"
         if r["closed_form_mode"] != r["key"]:
             line += f"  (against the closed form's {r['closed_form_mode']}: the two share one motion)"
-        if math.isnan(r["calm_linear_s"]):
+        if math.isnan(r["calm_linear_s"]) and not r["calm_overdamped"]:
             line += "  (no linear mode carries this name: see 'aerostat-gym stability')"
         lines.append(line.rstrip())
     return "\n".join(lines)

@@ -241,7 +241,9 @@ def sensitivity_table(params: Params | None = None, knobs: list[Knob] | None = N
             row[end + "_result"] = res
             if "error" not in res:
                 row[end + "_pct"] = {key: 100 * (res[key] - base[key]) / base[key] for key in PERIOD_KEYS}
-        row["max_abs_pct"] = max((abs(v) for end in ("low_pct", "high_pct") for v in row.get(end, {}).values()),
+        # a period that stops existing (the mode overdamped or gone: NaN) is the largest change
+        row["max_abs_pct"] = max((math.inf if math.isnan(v) else abs(v)
+                                  for end in ("low_pct", "high_pct") for v in row.get(end, {}).values()),
                                  default=math.inf)
         rows.append(row)
     rows.sort(key=lambda r: -r["max_abs_pct"])
@@ -269,7 +271,8 @@ def format_sensitivity(table: dict) -> str:
         lines.append(f"{r['label']:32s} {r['low']:8.4g}-{r['high']:<8.4g} " + " ".join(f"{c:>13s}" for c in cells)
                      + f" {zl}/{zh}{_verdict(ends)}")
     if any("n/a" in line for line in lines):
-        lines.append("n/a: no trim at that end, or no mode of that name (--json has the errors)")
+        lines.append("n/a: no trim at that end (--json has the error), the mode overdamped there "
+                     "(a real eigenvalue: no period), or no mode of that name")
     return "\n".join(lines)
 
 
