@@ -8,10 +8,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from aerostat_gym.agents.evaluate import run_scenario
+from aerostat_gym.agents.evaluate import evaluate_policy, run_scenario
 from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy, load_policy
 from aerostat_gym.agents.sb3io import PolicyError
 from aerostat_gym.agents.train import train
+from aerostat_gym.analysis.reference import closed_form_periods
 from aerostat_gym.cli import main
 from aerostat_gym.envs.spaces import N_OBS
 from aerostat_gym.resources import shipped_path
@@ -198,3 +199,19 @@ def test_suite_at_other_speeds_is_the_suite_cell_it_replaces():
     passive = evaluate_policy("passive", "damping", speeds=[18.0])
     assert new[18.0]["pendulum_zeta"] > 1.5 * passive["scenarios"]["recover"]["episodes"][0][
         "pendulum_zeta"]  # 0.85 against 0.39 when written
+
+
+def test_scheduled_controllers_are_the_braked_winch_in_still_air_and_say_so():
+    """At U = 0 the gains fade to zero (agents.lqr.low_wind_fade: no linear authority over a
+    vertical tether's pendulum): the LQR's still-air recovery is the braked winch's, sample
+    for sample, and the evaluator warns rather than let the identical rows pass unexplained."""
+    with pytest.warns(UserWarning, match="U = 0 m/s.*no linear authority"):
+        lqr = evaluate_policy("lqr", suite="damping", speeds=[0.0])
+    passive = evaluate_policy("passive", suite="damping", speeds=[0.0])
+    a, b = (r["scenarios"]["recover"]["episodes"][0] for r in (lqr, passive))
+    assert a["peak_reel_speed_m_s"] == 0.0
+    for key in ("pendulum_zeta", "pitch_zeta", "rms_x_m", "peak_tension_N"):
+        assert a[key] == b[key], key
+    # the still-air pendulum against its closed form (44.87 s)
+    assert b["pendulum_period_s"] == pytest.approx(closed_form_periods()["long_pendulum"],
+                                                   rel=0.005)

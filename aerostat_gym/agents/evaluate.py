@@ -38,6 +38,7 @@ The suite score is the mean episode return under the environment's default rewar
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -46,7 +47,8 @@ from ..envs.batch import held_wind_top
 from ..envs.config import DEFAULT_WIND_RANGE, check_control_step
 from ..envs.spaces import N_OBS
 from ..envs.vector import TetheredAerostatVectorEnv
-from ..params import as_params, dumps_toml
+from ..params import Params, as_params, dumps_toml
+from .fit_guides import drop_stray_pitch, guide_kwargs, guides_for
 from .metrics import response_metrics
 from .policies import load_policy
 from .sb3io import PolicyError
@@ -235,6 +237,7 @@ class Episodes:
     y: np.ndarray | None = None  # cross-wind CM displacement from trim [m]
     pitch_rate: np.ndarray | None = None  # body rate q [rad/s]
     length: np.ndarray | None = None  # paid-out tether length minus trim [m]
+    params: Params | None = None  # the aerostat the episodes ran on (None: the baseline)
 
 
 def check_suite(name: str) -> dict:
@@ -282,7 +285,7 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     t = np.arange(steps + 1) * control_step
     return Episodes(scenario, np.array([u for u, _ in pairs]), np.array([s for _, s in pairs]),
                     t, rec["x"], rec["pitch"], rec["tension"], rec["reel"], returns, ended,
-                    y=rec["y"], pitch_rate=rec["q"], length=rec["length"])
+                    y=rec["y"], pitch_rate=rec["q"], length=rec["length"], params=b.params)
 
 
 def rollout(policy, env, obs: np.ndarray, steps: int, record=None) -> tuple[np.ndarray, list]:
@@ -324,16 +327,20 @@ def policy_obs(policy, obs: np.ndarray) -> np.ndarray:
 def episode_metrics(ep: Episodes, i: int) -> dict:
     """Per-episode metrics (:func:`aerostat_gym.agents.metrics.response_metrics`) with the
     wind speed, seed, return, termination reason (``ended``) and ``terminated`` (1.0 or 0.0).
-    The lateral pendulum is fitted only in scenarios that swing across the wind."""
+    The lateral pendulum is fitted only in scenarios that swing across the wind. On an
+    aerostat other than the baseline the fits start from its linear modes and a pitch fit that
+    caught none of its fast modes reads NaN (:mod:`aerostat_gym.agents.fit_guides`)."""
     sc = SCENARIOS.get(ep.scenario)
     lateral = sc is not None and "y" in sc.pendulums
 
     def row(a):
         return None if a is None else a[i]
 
-    m = response_metrics(ep.time, ep.x[i], ep.pitch[i], ep.tension[i], ep.reel_speed[i],
-                         y_disp=row(ep.y), pitch_rate=row(ep.pitch_rate),
-                         length_dev=row(ep.length), fit_lateral=lateral)
+    guides = guides_for(ep.params, float(ep.speeds[i]))
+    m = drop_stray_pitch(response_metrics(ep.time, ep.x[i], ep.pitch[i], ep.tension[i],
+                                          ep.reel_speed[i], y_disp=row(ep.y),
+                                          pitch_rate=row(ep.pitch_rate), length_dev=row(ep.length),
+                                          fit_lateral=lateral, **guide_kwargs(guides)), guides)
     m.update({"wind_speed": float(ep.speeds[i]), "seed": int(ep.seeds[i]),
               "return": float(ep.returns[i]), "ended": ep.ended[i],
               "terminated": float(ep.ended[i] is not None)})
@@ -376,6 +383,12 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
     cells = suite_cells(suite, speeds)
     noise = SUITE_OBS_NOISE.get(suite, 0.0)
     params = as_params(params)
+    if policy_name != "passive" and any(u == 0 for sp, _ in cells.values() for u in sp):
+        warnings.warn(f"{policy_name} at U = 0 m/s: in still air the tether hangs vertical and "
+                      "reeling moves the aerostat along it, so the winch has no linear authority "
+                      "over the pendulum; the scheduled controllers fade to the braked winch "
+                      "there (agents.lqr.low_wind_fade) and read as passive", UserWarning,
+                      stacklevel=2)
     policy = load_policy(policy_name, params=params, dt=control_step, obs_noise=noise,
                          wind_range=default_wind_range(params) if speeds is None
                          else cells_wind_range(cells, params))

@@ -11,7 +11,9 @@ simulator is the linearization there), and both differ from the pitching mode's 
 by the blend. The same function applies the three-mode fit of
 :mod:`aerostat_gym.agents.metrics_modes` to the linear response, started away from the modes,
 and it returns the pitching mode; :func:`pitching_mode_study` then measures the pitching mode's
-damping of each policy's nonlinear runs with it.
+damping of each policy's nonlinear runs with it. :func:`pitch_fit_coverage` counts, on any
+aerostat, how many of the evaluator's pitch fits catch one of its fast modes at all
+(:mod:`aerostat_gym.agents.fit_guides`).
 """
 
 from __future__ import annotations
@@ -23,7 +25,17 @@ from ..analysis.modes import analyse
 from ..analysis.trim import find_equilibrium
 from ..envs.config import DEFAULT_WIND_RANGE
 from ..envs.vector import TetheredAerostatVectorEnv
-from .evaluate import SCENARIOS, run_scenario
+from ..params import as_params
+from .evaluate import (
+    RECOVER_SCENARIOS,
+    SCENARIOS,
+    SENSOR_NOISE,
+    cells_episodes,
+    cells_wind_range,
+    episode_metrics,
+    run_scenario,
+)
+from .fit_guides import FAST_MODE_FACTOR, fit_guides, is_baseline
 from .frontier import linear_response
 from .metrics import _failed, fit_damped_sinusoid, response_metrics
 from .metrics_modes import fit_modes, nearest_mode
@@ -151,3 +163,32 @@ def study_markdown(studies: list[dict]) -> str:
                          f"{st['linear_pitching_zeta']:.3f} | {r['policy']} | {r['zeta']:.3f} | "
                          f"{diff} |")
     return "\n".join(lines) + "\n"
+
+
+def pitch_fit_coverage(params, policies, speeds=(5.0, 10.0, 15.0), seeds=(5000, 5001, 5002),
+                       obs_noise: float = SENSOR_NOISE) -> dict:
+    """How many of the evaluator's pitch fits on an aerostat caught one of its fast modes:
+    each named policy in every recover scenario at ``speeds`` and ``seeds`` (the report suite's
+    sensor noise by default), fitted as :func:`~.evaluate.episode_metrics` fits them (guided on
+    any aerostat but the baseline). Returns the number of fits, how many read n/a (more than
+    :data:`~.fit_guides.FAST_MODE_FACTOR` from both linear fast modes, or no oscillation
+    found), the largest ratio among the others (:meth:`~.fit_guides.FitGuides.fast_mode_ratio`)
+    and whether the fits were guided."""
+    params = as_params(params)
+    cells = {scenario: (list(speeds), list(seeds)) for scenario in RECOVER_SCENARIOS}
+    fits = stray = 0
+    worst = 1.0
+    for name in policies:
+        policy = load_policy(name, params=params, obs_noise=obs_noise,
+                             wind_range=cells_wind_range(cells, params))
+        for _, ep in cells_episodes(policy, cells, obs_noise, params=params):
+            for i in range(len(ep.speeds)):
+                m = episode_metrics(ep, i)
+                g = fit_guides(params, float(ep.speeds[i]))
+                ratio = g.fast_mode_ratio(m["pitch_zeta"], m["pitch_period_s"])
+                fits += 1
+                if ratio > FAST_MODE_FACTOR:
+                    stray += 1
+                else:
+                    worst = max(worst, ratio)
+    return {"fits": fits, "stray": stray, "worst_ratio": worst, "guided": not is_baseline(params)}
