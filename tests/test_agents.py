@@ -10,6 +10,7 @@ import pytest
 
 from aerostat_gym.agents.evaluate import evaluate_policy, run_scenario
 from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy, load_policy
+from aerostat_gym.agents.report import comparison_table, lqr_predictions
 from aerostat_gym.agents.sb3io import PolicyError
 from aerostat_gym.agents.train import train
 from aerostat_gym.analysis.reference import closed_form_periods
@@ -215,3 +216,34 @@ def test_scheduled_controllers_are_the_braked_winch_in_still_air_and_say_so():
     # the still-air pendulum against its closed form (44.87 s)
     assert b["pendulum_period_s"] == pytest.approx(closed_form_periods()["long_pendulum"],
                                                    rel=0.005)
+
+
+def _result(label, scenario, episodes):
+    return {"label": label, "scenarios": {scenario: {"episodes": episodes}}}
+
+
+def test_report_tables_show_each_scenarios_pendulum_and_its_terminations():
+    """A cross-wind scenario shows the lateral fit (it showed the barely excited longitudinal
+    one); a cell whose episodes ended says how, under the table."""
+    ep = {"wind_speed": 10.0, "pendulum_zeta": 1.0, "pendulum_period_s": 92.5,
+          "lateral_pendulum_zeta": 0.341, "lateral_pendulum_period_s": 60.2, "ended": None}
+    cross = comparison_table([_result("passive", "recover_cross", [ep])], "recover_cross")
+    head, row = cross.splitlines()[0], cross.splitlines()[2]
+    assert "lat. pend. zeta" in head and "| pend. zeta" not in head
+    assert "| 0.341 | 60.2 |" in row and "92.5" not in row
+    along = comparison_table([_result("passive", "recover", [ep])], "recover")
+    assert "| 1.000 | 92.5 |" in along and "lat. pend." not in along
+    broken = [{"wind_speed": 15.0, "rms_x_m": float("nan"), "ended": "tether_break"},
+              {"wind_speed": 15.0, "rms_x_m": 2.0, "ended": None}]
+    gusty = comparison_table([_result("lqr", "gusty", broken)], "gusty")
+    assert "| 15 | lqr | 2.00 |" in gusty
+    assert gusty.splitlines()[-1] == "- lqr at 15 m/s: 1 of 2 episodes ended by tether_break"
+
+
+def test_model_based_predictions_name_the_policy_and_its_design_speed():
+    pred = {"design_wind_speed": 9.0, "pendulum": {"open": {"zeta": 0.287},
+                                                   "closed": {"zeta": 0.829}},
+            "pitching": {"closed": {"zeta": 0.427}}}
+    ep = {"wind_speed": 15.0, "pendulum_zeta": float("nan"), "pitch_zeta": 0.4, "predicted": pred}
+    table = lqr_predictions([_result("lqr", "recover", [ep])])
+    assert table.splitlines()[-1] == "| 15 | lqr | 9 | 0.287 | 0.829 | n/a | 0.427 | 0.400 |"

@@ -20,6 +20,7 @@ from aerostat_gym.agents.fit_guides import (
     FitGuides,
     fit_guides,
     guides_for,
+    screen_fits,
 )
 from aerostat_gym.agents.metrics import response_metrics
 from aerostat_gym.agents.pitch_check import pitch_fit_coverage
@@ -34,6 +35,10 @@ BASE = load_params()
 #: modes of 0.8-1.6 s that the unguided fits miss.
 HULL_5M = scale_aerostat(BASE, (5.0 / 18.3) ** 3, 100.0)
 SHORT_60M = scale_aerostat(BASE, 0.05, 60.0)
+#: The baseline on 1500 m (a pendulum overdamped from 10 m/s) and at 585 kg (near-neutral:
+#: slow axial spring, lateral pendulum longer than the record).
+LONG_1500M = scale_aerostat(BASE, 1.0, 1500.0)
+HEAVY = load_params(overrides={"aerostat.mass": 585.0})
 
 
 def _damped(mode):
@@ -83,6 +88,62 @@ def test_pitch_found_within_the_factor_of_a_fast_mode(zeta, damped, found):
     natural = damped * math.sqrt(1.0 - zeta**2) if zeta < 1.0 else damped
     assert FAST_MODE_FACTOR == 1.5
     assert g.pitch_found(zeta, natural) is found
+
+
+def _guides(pitch=2.0, axial=3.0, pendulum=40.0, lateral=50.0):
+    return FitGuides(pendulum_period=pendulum, pitch_period=pitch, axial_period=axial,
+                     lateral_period=lateral, pitch_highpass_hz=0.1)
+
+
+def test_the_axial_spring_counts_as_pitch_only_where_it_blends_with_the_pitching_mode():
+    assert _guides(2.0, 3.0).pitch_modes() == (2.0, 3.0)  # 1.5 x: the baseline's blend
+    assert _guides(3.41, 20.0).pitch_modes() == (3.41,)  # a near-neutral aerostat's
+    assert not _guides(3.41, 20.0).pitch_found(0.3, 16.7)
+    assert _guides(3.41, 20.0).pitch_found(0.3, 3.41 * math.sqrt(1 - 0.09))
+
+
+def _metrics(zeta, period, lat_zeta=0.2, lat_period=50.0):
+    return {"pitch_zeta": 0.3, "pitch_period_s": 2.0 * math.sqrt(1 - 0.09),
+            "pendulum_zeta": zeta, "pendulum_period_s": period,
+            "lateral_pendulum_zeta": lat_zeta, "lateral_pendulum_period_s": lat_period}
+
+
+@pytest.mark.parametrize("zeta, period, linear, expect", [
+    (0.3, 40.0, 40.0, (0.3, 40.0)),                  # resolved: kept
+    (1.0 - 1e-9, 120.0, None, (1.0 - 1e-9, "nan")),  # railed, linear overdamped: zeta 1, no T
+    (1.0 - 1e-9, 37.5, 30.0, (1.0 - 1e-9, "nan")),   # railed: 2 pi / sigma is not a period
+    (0.2, 150.0, 200.0, ("nan", "nan")),             # linear swing longer than the 180 s record
+    (0.9, 90.0, 100.0, ("nan", "nan")),              # fitted damped period 206 s > 180 s
+])
+def test_screen_fits_keeps_only_what_the_record_resolves(zeta, period, linear, expect):
+    out = screen_fits(_metrics(zeta, period), _guides(pendulum=linear), 180.0)
+    got = tuple("nan" if math.isnan(v) else v for v in (out["pendulum_zeta"],
+                                                          out["pendulum_period_s"]))
+    assert got == expect
+    assert out["pitch_zeta"] == 0.3  # the pitching mode itself: kept
+    assert screen_fits(_metrics(zeta, period), None, 180.0) == _metrics(zeta, period)
+
+
+def test_an_overdamped_pendulum_reads_zeta_one_without_a_period():
+    """The baseline on 1500 m at 10 m/s: the linear pendulum is a real root, the braked
+    record's fit rails to zeta = 1; the evaluator prints 1.000 with no period (it printed
+    2 pi / sigma, 133-149 s, as one)."""
+    analysis = analyse(LONG_1500M, find_equilibrium(LONG_1500M, 10.0))
+    assert not analysis.find("long", "pendulum").oscillatory
+    ep = run_scenario(PassivePolicy(), "recover", [10.0], [0], env_kwargs={"params": LONG_1500M})
+    assert _unguided(ep)["pendulum_zeta"] > 0.999
+    m = episode_metrics(ep, 0)
+    assert m["pendulum_zeta"] > 0.999 and math.isnan(m["pendulum_period_s"])
+
+
+def test_a_lateral_pendulum_longer_than_the_record_reads_nan():
+    """585 kg at 5 m/s: the linear lateral pendulum (360.6 s, zeta 0.15: 364.7 s damped) is
+    twice the 180 s record; its fit (0.21 against the linear 0.15) is not reported."""
+    g = fit_guides(HEAVY, 5.0)
+    assert g.lateral_period == pytest.approx(364.7, rel=0.01)
+    ep = run_scenario(PassivePolicy(), "recover_cross", [5.0], [0], env_kwargs={"params": HEAVY})
+    m = episode_metrics(ep, 0)
+    assert math.isnan(m["lateral_pendulum_zeta"]) and math.isnan(m["lateral_pendulum_period_s"])
 
 
 def _unguided(ep, i=0):

@@ -48,7 +48,7 @@ from ..envs.config import DEFAULT_WIND_RANGE, check_control_step
 from ..envs.spaces import N_OBS
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import Params, as_params, dumps_toml
-from .fit_guides import drop_stray_pitch, guide_kwargs, guides_for
+from .fit_guides import guide_kwargs, guides_for, screen_fits
 from .metrics import response_metrics
 from .policies import load_policy
 from .sb3io import PolicyError
@@ -328,8 +328,8 @@ def episode_metrics(ep: Episodes, i: int) -> dict:
     """Per-episode metrics (:func:`aerostat_gym.agents.metrics.response_metrics`) with the
     wind speed, seed, return, termination reason (``ended``) and ``terminated`` (1.0 or 0.0).
     The lateral pendulum is fitted only in scenarios that swing across the wind. On an
-    aerostat other than the baseline the fits start from its linear modes and a pitch fit that
-    caught none of its fast modes reads NaN (:mod:`aerostat_gym.agents.fit_guides`)."""
+    aerostat other than the baseline the fits start from its linear modes and the fits the
+    record cannot support read NaN (:func:`aerostat_gym.agents.fit_guides.screen_fits`)."""
     sc = SCENARIOS.get(ep.scenario)
     lateral = sc is not None and "y" in sc.pendulums
 
@@ -337,10 +337,11 @@ def episode_metrics(ep: Episodes, i: int) -> dict:
         return None if a is None else a[i]
 
     guides = guides_for(ep.params, float(ep.speeds[i]))
-    m = drop_stray_pitch(response_metrics(ep.time, ep.x[i], ep.pitch[i], ep.tension[i],
-                                          ep.reel_speed[i], y_disp=row(ep.y),
-                                          pitch_rate=row(ep.pitch_rate), length_dev=row(ep.length),
-                                          fit_lateral=lateral, **guide_kwargs(guides)), guides)
+    m = screen_fits(response_metrics(ep.time, ep.x[i], ep.pitch[i], ep.tension[i],
+                                     ep.reel_speed[i], y_disp=row(ep.y),
+                                     pitch_rate=row(ep.pitch_rate), length_dev=row(ep.length),
+                                     fit_lateral=lateral, **guide_kwargs(guides)),
+                    guides, float(ep.time[-1] - ep.time[0]))
     m.update({"wind_speed": float(ep.speeds[i]), "seed": int(ep.seeds[i]),
               "return": float(ep.returns[i]), "ended": ep.ended[i],
               "terminated": float(ep.ended[i] is not None)})
@@ -369,6 +370,17 @@ def cells_episodes(policy, cells: dict, obs_noise: float, control_step: float = 
                                      env_kwargs=kwargs)
 
 
+def warn_still_air(policy_name: str, cells: dict) -> None:
+    """Warn where ``cells`` run a policy other than the braked winch at U = 0, where it reads
+    as the braked winch."""
+    if policy_name != "passive" and any(u == 0 for sp, _ in cells.values() for u in sp):
+        warnings.warn(f"{policy_name} at U = 0 m/s: in still air the tether hangs vertical and "
+                      "reeling moves the aerostat along it, so the winch has no linear authority "
+                      "over the pendulum; the scheduled controllers fade to the braked winch "
+                      "there (agents.lqr.low_wind_fade) and read as passive", UserWarning,
+                      stacklevel=3)
+
+
 def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float = 0.2,
                     params=None, speeds=None) -> dict:
     """Metrics of one policy on a suite: {scenario: [per-episode metrics]}, plus the score.
@@ -383,12 +395,7 @@ def evaluate_policy(policy_name: str, suite: str = "tiny", control_step: float =
     cells = suite_cells(suite, speeds)
     noise = SUITE_OBS_NOISE.get(suite, 0.0)
     params = as_params(params)
-    if policy_name != "passive" and any(u == 0 for sp, _ in cells.values() for u in sp):
-        warnings.warn(f"{policy_name} at U = 0 m/s: in still air the tether hangs vertical and "
-                      "reeling moves the aerostat along it, so the winch has no linear authority "
-                      "over the pendulum; the scheduled controllers fade to the braked winch "
-                      "there (agents.lqr.low_wind_fade) and read as passive", UserWarning,
-                      stacklevel=2)
+    warn_still_air(policy_name, cells)
     policy = load_policy(policy_name, params=params, dt=control_step, obs_noise=noise,
                          wind_range=default_wind_range(params) if speeds is None
                          else cells_wind_range(cells, params))

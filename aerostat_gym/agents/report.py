@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -11,18 +12,24 @@ import numpy as np
 from ..checks import is_number
 from ..resources import SHIPPED_POLICY
 from . import protocol as proto_mod
-from .evaluate import SCENARIOS, describe_suite, evaluate_policy
+from .evaluate import SCENARIOS, describe_suite, evaluate_policy, suite_cells, warn_still_air
 from .policies import BASELINES
 from .protocol_stats import bootstrap_mean_ci
 
 COLUMNS = [  # (key, header, format)
     ("pendulum_zeta", "pend. zeta", "{:.3f}"), ("pendulum_period_s", "pend. T [s]", "{:.1f}"),
+    ("lateral_pendulum_zeta", "lat. pend. zeta", "{:.3f}"),
+    ("lateral_pendulum_period_s", "lat. pend. T [s]", "{:.1f}"),
     ("pitch_zeta", "pitch zeta", "{:.3f}"), ("pitch_period_s", "pitch T [s]", "{:.2f}"),
     ("settling_time_s", "5 % settle [s]", "{:.0f}"), ("rms_x_m", "RMS x [m]", "{:.2f}"),
     ("rms_pitch_rad", "RMS pitch [deg]", "deg"), ("peak_tension_N", "peak T [kN]", "kN"),
     ("rms_tension_N", "RMS T [kN]", "kN"), ("winch_energy_J", "winch energy [kJ]", "kN"),
     ("peak_reel_speed_m_s", "peak reel [m/s]", "{:.2f}"), ("return", "return", "{:.0f}"),
 ]
+#: The columns of each pendulum a free-response scenario fits ("x": longitudinal, "y":
+#: lateral; :attr:`~aerostat_gym.agents.evaluate.Scenario.pendulums`).
+PENDULUM_COLUMNS = {"x": {"pendulum_zeta", "pendulum_period_s"},
+                    "y": {"lateral_pendulum_zeta", "lateral_pendulum_period_s"}}
 
 
 def _fmt(value, fmt: str) -> str:
@@ -41,19 +48,37 @@ FREE_RESPONSE_ONLY = {"pendulum_zeta", "pendulum_period_s", "pitch_zeta", "pitch
 
 
 def comparison_table(results: list[dict], scenario: str) -> str:
-    """Markdown table: one row per (wind speed, policy), averaged over the scenario's seeds
-    (the gusty scenario shows no fitted damping: its response is forced, not free)."""
-    free = scenario in SCENARIOS and SCENARIOS[scenario].free
-    cols = [c for c in COLUMNS if free or c[0] not in FREE_RESPONSE_ONLY]
+    """Markdown table: one row per (wind speed, policy), averaged over the scenario's seeds,
+    with the fits of the pendulums the scenario swings (the gusty scenario shows no fitted
+    damping: its response is forced, not free), then a line per policy and wind speed whose
+    episodes terminated (their RMS and peak figures are n/a)."""
+    cols = scenario_columns(scenario)
     head = "| U [m/s] | policy | " + " | ".join(h for _, h, _ in cols) + " |"
     lines = [head, "|" + "---|" * (len(cols) + 2)]
     speeds = sorted({e["wind_speed"] for r in results for e in r["scenarios"][scenario]["episodes"]})
+    ended = []
     for u in speeds:
         for r in results:
             eps = [e for e in r["scenarios"][scenario]["episodes"] if e["wind_speed"] == u]
             cells = [_fmt(_mean(eps, k), f) for k, _, f in cols]
             lines.append(f"| {u:g} | {r['label']} | " + " | ".join(cells) + " |")
+            reasons = Counter(e["ended"] for e in eps if e.get("ended"))
+            if reasons:
+                ended.append(f"- {r['label']} at {u:g} m/s: " + ", ".join(
+                    f"{n} of {len(eps)} episodes ended by {why}" for why, n in reasons.items()))
+    if ended:
+        lines += ["", "Terminated (no RMS or peak figures for those episodes):", *ended]
     return "\n".join(lines)
+
+
+def scenario_columns(scenario: str) -> list:
+    """:data:`COLUMNS` for one scenario: the fits only of the pendulums it swings."""
+    sc = SCENARIOS.get(scenario)
+    pendulums = sc.pendulums if sc is not None else ()
+    skip = set().union(*(PENDULUM_COLUMNS[k] for k in PENDULUM_COLUMNS if k not in pendulums))
+    if not pendulums:
+        skip |= FREE_RESPONSE_ONLY
+    return [c for c in COLUMNS if c[0] not in skip]
 
 
 def _mean(eps: list[dict], key: str) -> float:
@@ -63,7 +88,9 @@ def _mean(eps: list[dict], key: str) -> float:
 
 
 def lqr_predictions(results: list[dict]) -> str:
-    """The LQR's linear closed-loop prediction next to what the nonlinear runs identified."""
+    """Each model-based controller's linear closed-loop prediction (the design at the schedule
+    speed nearest the run's, named in its own column) next to what the nonlinear runs
+    identified, in ``recover``."""
     lines = []
     for r in results:
         for e in r["scenarios"].get("recover", {}).get("episodes", []):
@@ -71,15 +98,21 @@ def lqr_predictions(results: list[dict]) -> str:
             if not pred:
                 continue
             p, q = pred.get("pendulum", {}), pred.get("pitching", {})
-            lines.append(f"| {e['wind_speed']:g} | {p.get('open', {}).get('zeta', float('nan')):.3f}"
-                         f" | {p.get('closed', {}).get('zeta', float('nan')):.3f} | "
-                         f"{e['pendulum_zeta']:.3f} | {q.get('closed', {}).get('zeta', float('nan')):.3f}"
-                         f" | {e['pitch_zeta']:.3f} |")
+            cells = [_zeta(p, "open"), _zeta(p, "closed"), _fmt(e["pendulum_zeta"], "{:.3f}"),
+                     _zeta(q, "closed"), _fmt(e["pitch_zeta"], "{:.3f}")]
+            lines.append(f"| {e['wind_speed']:g} | {r['label']} | "
+                         f"{_fmt(pred.get('design_wind_speed'), '{:g}')} | " + " | ".join(cells)
+                         + " |")
     if not lines:
         return ""
-    return ("| U [m/s] | pendulum zeta, braked (linear) | pendulum zeta, LQR (linear) | "
-            "pendulum zeta, LQR (nonlinear fit) | pitching zeta, LQR (linear) | "
-            "pitch zeta, LQR (nonlinear fit) |\n|---|---|---|---|---|---|\n" + "\n".join(lines))
+    return ("| U [m/s] | policy | design U [m/s] | pendulum zeta, braked (linear) | pendulum "
+            "zeta, closed loop (linear) | pendulum zeta (nonlinear fit) | pitching zeta, closed "
+            "loop (linear) | pitch zeta (nonlinear fit) |\n|---|---|---|---|---|---|---|---|\n"
+            + "\n".join(lines))
+
+
+def _zeta(mode: dict, loop: str) -> str:
+    return _fmt(mode.get(loop, {}).get("zeta"), "{:.3f}")
 
 
 #: Pendulum damping-ratio differences below this are called "within tolerance", not better or
@@ -228,7 +261,8 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
         parts += [f"## {scenario}", "", comparison_table(results, scenario), ""]
     pred = lqr_predictions(results)
     if pred:
-        parts += ["## LQR: linear prediction vs nonlinear simulation", "", pred, ""]
+        parts += ["## Model-based controllers: linear prediction vs nonlinear simulation", "",
+                  pred, ""]
     v = verdicts(results)
     if v:
         parts += ["## Learned policy vs baselines (pendulum damping, recover)", "", *v, ""]
@@ -320,6 +354,8 @@ def run_evaluations(policies: list[str], suite: str, progress: bool = True,
     """Evaluate every policy on ``suite`` (at ``speeds`` if given) in the environment of
     ``params`` (default baseline)."""
     labels = policy_labels(policies)
+    for name in policies:  # before the progress bar, not on its line
+        warn_still_air(name, suite_cells(suite, speeds))
     results = []
     for name, label in zip(_progress(policies, progress, "evaluating"), labels, strict=True):
         r = evaluate_policy(name, suite, params=params, speeds=speeds)
