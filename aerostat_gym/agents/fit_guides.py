@@ -14,7 +14,9 @@ of the aerostat the episodes ran on. Its periods only *start* the fits (every fi
 refines period and damping freely), so they steer the fit to the right mode without setting
 its answer. The high-pass cutoff scales with the geometric mean of the pendulum and pitching
 frequencies, anchored to the baseline's 0.1 Hz: the same separation, in the same proportion,
-on every aerostat. On the baseline the evaluator does not use the guides (its fits find these
+on every aerostat. :func:`screen_fits` then sets to NaN what the record cannot support: a pitch
+fit that caught none of the fast modes, a pendulum slower than the record, the "period" of a
+fit that found no oscillation. On the baseline the evaluator does neither (its fits find these
 modes unaided and its stored reports were measured so); see :func:`guides_for`.
 """
 
