@@ -70,7 +70,7 @@ class FitGuides:
         pitching mode."""
         if not (math.isfinite(zeta) and math.isfinite(period) and 0.0 <= zeta < 1.0):
             return math.inf
-        damped = period / math.sqrt(1.0 - zeta**2)
+        damped = _damped(zeta, period)
         return min((_ratio(damped, ref) for ref in self.pitch_modes()), default=math.inf)
 
     def pitch_modes(self) -> tuple:
@@ -92,11 +92,17 @@ def _ratio(a: float, b: float) -> float:
     return max(a / b, b / a)
 
 
+def _damped(zeta: float, period: float) -> float:
+    """2 pi / w_d [s] (the period a record shows) of a mode of natural period ``period`` and
+    damping ratio 0 <= ``zeta`` < 1."""
+    return period / math.sqrt(1.0 - zeta**2)
+
+
 def _damped_period(mode) -> float | None:
-    """2 pi / w_d of an oscillatory linear mode (the period a record shows); None otherwise."""
+    """:func:`_damped` of an oscillatory linear mode; None otherwise."""
     if mode is None or not mode.oscillatory or not 0.0 <= mode.zeta < 1.0:
         return None
-    return mode.period / math.sqrt(1.0 - mode.zeta**2)
+    return _damped(mode.zeta, mode.period)
 
 
 def _separation_hz(analysis) -> float | None:
@@ -187,6 +193,6 @@ def screen_fits(metrics: dict, guides: FitGuides | None, record_s: float) -> dic
         if zeta >= RAILED_ZETA:
             metrics[pkey] = math.nan
         if (linear is not None and linear > record_s) or (
-                zeta < RAILED_ZETA and period / math.sqrt(1.0 - zeta**2) > record_s):
+                zeta < RAILED_ZETA and _damped(zeta, period) > record_s):
             metrics[zkey] = metrics[pkey] = math.nan
     return metrics

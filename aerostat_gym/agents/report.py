@@ -12,7 +12,7 @@ import numpy as np
 from ..checks import is_number
 from ..resources import SHIPPED_POLICY
 from . import protocol as proto_mod
-from .evaluate import SCENARIOS, describe_suite, evaluate_policy, suite_cells, warn_still_air
+from .evaluate import SCENARIOS, describe_suite, evaluate_policy
 from .policies import BASELINES
 from .protocol_stats import bootstrap_mean_ci
 
@@ -354,8 +354,6 @@ def run_evaluations(policies: list[str], suite: str, progress: bool = True,
     """Evaluate every policy on ``suite`` (at ``speeds`` if given) in the environment of
     ``params`` (default baseline)."""
     labels = policy_labels(policies)
-    for name in policies:  # before the progress bar, not on its line
-        warn_still_air(name, suite_cells(suite, speeds))
     results = []
     for name, label in zip(_progress(policies, progress, "evaluating"), labels, strict=True):
         r = evaluate_policy(name, suite, params=params, speeds=speeds)

@@ -11,6 +11,8 @@ import math
 import sys
 from pathlib import Path
 
+from tqdm import tqdm
+
 from ..params import ParameterError, load_params, shipped_configs, tomllib
 
 
@@ -23,8 +25,9 @@ class OneLineParser(argparse.ArgumentParser):
 
 
 def warn(command: str, message: str) -> None:
-    """One warning line on stderr."""
-    print(f"aerostat-gym {command}: warning: {message}", file=sys.stderr)
+    """One warning line on stderr, on a line of its own while a progress bar runs."""
+    with tqdm.external_write_mode(file=sys.stderr):
+        print(f"aerostat-gym {command}: warning: {message}", file=sys.stderr)
 
 
 def _number(text: str) -> float:
