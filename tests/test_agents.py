@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -247,3 +248,45 @@ def test_model_based_predictions_name_the_policy_and_its_design_speed():
     ep = {"wind_speed": 15.0, "pendulum_zeta": float("nan"), "pitch_zeta": 0.4, "predicted": pred}
     table = lqr_predictions([_result("lqr", "recover", [ep])])
     assert table.splitlines()[-1] == "| 15 | lqr | 9 | 0.287 | 0.829 | n/a | 0.427 | 0.400 |"
+
+
+def test_recover_displacements_scale_with_the_tether():
+    """The recover scenarios swing every aerostat through the same angle: their displacements
+    are the baseline's 300 m tether's, times L / 300 m on another tether (the pitch kick is an
+    angle and is kept). On 0.05 x the volume on 60 m the 10 m swing is 2 m: the tether turns
+    about the winch through 2 m / the CM's height (1e-6), the episode starts there, and the
+    description says so; on the baseline the scenarios and their descriptions are unchanged."""
+    from aerostat_gym.agents.evaluate import (
+        REFERENCE_TETHER_LENGTH,
+        SCENARIOS,
+        describe_suite,
+    )
+    from aerostat_gym.agents.pitch_check import scenario_start
+    from aerostat_gym.analysis.trim import find_equilibrium
+    from aerostat_gym.params import load_params
+    from aerostat_gym.physics.state import StateLayout
+    from aerostat_gym.scaling import scale_aerostat
+
+    assert REFERENCE_TETHER_LENGTH == load_params().tether.length
+    rec, cross = SCENARIOS["recover"], SCENARIOS["recover_combined_small"]
+    assert rec.env_kwargs_for(None) == rec.env_kwargs == rec.env_kwargs_for(300.0)
+    assert rec.env_kwargs_for(60.0, scale=1.0) == rec.env_kwargs  # the stated metres, asked for
+    assert rec.describe() == "calm, 10 m along-wind swing + 0.05 rad pitch"
+    assert cross.describe() == "calm, 0.707 m along + 0.707 m across + 0.005 rad pitch"
+    pert = cross.env_kwargs_for(600.0)["perturbation"]
+    assert (pert["swing"], pert["lateral"], pert["pitch"]) == pytest.approx((1.4142, 1.4142, 0.005),
+                                                                          abs=1e-4)
+    assert SCENARIOS["gusty"].env_kwargs_for(60.0) == SCENARIOS["gusty"].env_kwargs
+    assert "x 0.2 for the 60 m tether" in rec.describe(60.0)
+    assert "2 m along-wind swing" in describe_suite("damping", tether_length=60.0)
+    p = scale_aerostat(load_params(), 0.05, 60.0)
+    dx = scenario_start(p, 10.0, "recover")
+    lay = StateLayout(p.tether.n_elements)
+    trim = find_equilibrium(p, 10.0).x
+    top, top0 = (trim + dx)[lay.node_pos][:3], trim[lay.node_pos][:3]
+    turned = math.atan2(top[0], top[2]) - math.atan2(top0[0], top0[2])  # about the winch
+    assert turned * trim[lay.cm_pos][2] == pytest.approx(2.0, rel=1e-6)
+    # the nose faces upwind, so turning the whole downwind pitches it down by the same angle
+    assert dx[lay.euler.start + 1] == pytest.approx(0.05 - turned, rel=1e-6)
+    ep = run_scenario(PassivePolicy(), "recover", [10.0], [0], env_kwargs={"params": p})
+    assert ep.x[0, 0] == pytest.approx(dx[lay.cm_pos.start], rel=1e-9)

@@ -159,10 +159,12 @@ def test_baseline_metrics_are_the_unguided_fits():
 
 
 def test_guided_pitch_fit_finds_the_fast_mode_the_unguided_one_misses():
-    """0.05 x the volume on 60 m, braked, 5 m/s: the unguided fit reads zeta 1.0 at 4.5 s (no
-    oscillation, a slow remainder); started at the linear pitching mode (1.62 s damped) it
-    finds the fast mode (1.96 s natural, within 1.5 x of the linear pitching mode)."""
-    ep = run_scenario(PassivePolicy(), "recover", [5.0], [0], env_kwargs={"params": SHORT_60M})
+    """0.05 x the volume on 60 m, braked, 5 m/s, swung the reference's 10 m (not the 2 m the
+    scenario gives this tether): the unguided fit reads zeta 1.0 at 4.5 s (no oscillation, a
+    slow remainder); started at the linear pitching mode (1.62 s damped) it finds the fast
+    mode (1.96 s natural, within 1.5 x of the linear pitching mode)."""
+    ep = run_scenario(PassivePolicy(), "recover", [5.0], [0], env_kwargs={"params": SHORT_60M},
+                      displacement_scale=1.0)
     g = fit_guides(SHORT_60M, 5.0)
     old = _unguided(ep)
     assert not g.pitch_found(old["pitch_zeta"], old["pitch_period_s"])
@@ -174,10 +176,12 @@ def test_guided_pitch_fit_finds_the_fast_mode_the_unguided_one_misses():
 
 
 def test_a_stray_pitch_fit_reads_nan():
-    """The 5 m hull under the LQR at 10 m/s: the pitch history's dominant fast component is the
-    6.0 s winch loop, 2.9 x the axial spring's period: the pitch cells read n/a, not 6.0 s."""
+    """The 5 m hull under the LQR at 10 m/s, swung the reference's 10 m: the pitch history's
+    dominant fast component is the 6.0 s winch loop, 2.9 x the axial spring's period: the
+    pitch cells read n/a, not 6.0 s."""
     lqr = load_policy("lqr", params=HULL_5M, wind_range=(3.0, 16.0))
-    ep = run_scenario(lqr, "recover", [10.0], [0], env_kwargs={"params": HULL_5M})
+    ep = run_scenario(lqr, "recover", [10.0], [0], env_kwargs={"params": HULL_5M},
+                      displacement_scale=1.0)
     old = _unguided(ep)
     assert old["pitch_period_s"] == pytest.approx(6.0, abs=0.1)
     g = fit_guides(HULL_5M, 10.0)

@@ -18,6 +18,11 @@ the confluence point, :func:`aerostat_gym.envs.episodes._perturb`):
   field (sigma_u / U(h) = 5 %, 10 %, 15 % at the aerostat), no initial perturbation, 120 s: RMS
   displacement, pitch and pitch rate, tension, length wander, winch energy.
 
+The recover scenarios' displacements are stated for the baseline's 300 m tether
+(:data:`REFERENCE_TETHER_LENGTH`); on another tether they scale with its length, so that every
+aerostat is swung through the same angle (1.9 degrees for the 10 m swing), and the reports say
+so in each scenario's description.
+
 Suites (:data:`SUITES`) fix the wind speeds and seeds, so a number in a report can be
 reproduced exactly. ``damping``, ``tiny``, ``small`` and ``full`` run without sensor noise, so
 in the recover scenarios every seed is the same episode. ``report`` (the frozen protocol of
@@ -61,44 +66,84 @@ from .sb3io import PolicyError
 SENSOR_NOISE = 0.01
 
 
+#: The tether length [m] the recover scenarios' displacements are stated for: the baseline's.
+#: On another tether they scale with its length (:meth:`Scenario.env_kwargs_for`), so that the
+#: swing turns the tether through the same angle (10 m on 300 m: 1.9 degrees, where 10 m on a
+#: 30 m tether would be 19 degrees, far outside the linear regime the fits assume); the pitch
+#: kick is an angle and is kept.
+REFERENCE_TETHER_LENGTH = 300.0
+
+
+def amplitude_scale(tether_length: float | None) -> float:
+    """Factor on the recover scenarios' displacements for a tether of ``tether_length`` [m]
+    (None: the reference, factor 1)."""
+    return 1.0 if tether_length is None else float(tether_length) / REFERENCE_TETHER_LENGTH
+
+
 def _recover(along: float, lateral: float, pitch: float) -> dict:
     return {"turbulence": "none",
             "perturbation": {"swing": along, "lateral": lateral, "pitch": pitch, "fixed": True}}
 
 
+def _describe_start(pert: dict) -> str:
+    """'calm, 10 m along-wind swing + 0.05 rad pitch' and the like."""
+    along, lateral = pert["swing"], pert["lateral"]
+    swing = (f"{along:.3g} m along + {lateral:.3g} m across" if along and lateral else
+             f"{lateral:.3g} m cross-wind swing" if lateral else f"{along:.3g} m along-wind swing")
+    return f"calm, {swing} + {pert['pitch']:g} rad pitch"
+
+
 @dataclass(frozen=True)
 class Scenario:
-    """One evaluation scenario: environment keyword arguments, duration [s], a one-line
-    description and, for a free response, the displacements its pendulum fits use ("x":
-    along-wind, longitudinal pendulum; "y": cross-wind, lateral pendulum; empty for a forced
-    response, which gets no damping fits)."""
+    """One evaluation scenario: environment keyword arguments (for a tether of
+    :data:`REFERENCE_TETHER_LENGTH`), duration [s], a one-line description (of a forced
+    response; a free response's is written from its start) and, for a free response, the
+    displacements its pendulum fits use ("x": along-wind, longitudinal pendulum; "y":
+    cross-wind, lateral pendulum; empty for a forced response, which gets no damping fits)."""
 
     env_kwargs: dict
     duration: float
-    description: str
+    description: str = ""
     pendulums: tuple = ()
 
     @property
     def free(self) -> bool:
         return bool(self.pendulums)
 
+    def env_kwargs_for(self, tether_length: float | None = None,
+                       scale: float | None = None) -> dict:
+        """The environment keyword arguments on a tether of ``tether_length`` [m] (None: the
+        reference): a free response's swing and cross-wind displacement times ``scale``
+        (default :func:`amplitude_scale` of the tether)."""
+        if not self.free:
+            return dict(self.env_kwargs)
+        pert = self.env_kwargs["perturbation"]
+        k = amplitude_scale(tether_length) if scale is None else float(scale)
+        return {**self.env_kwargs,
+                "perturbation": {**pert, "swing": pert["swing"] * k, "lateral": pert["lateral"] * k}}
+
+    def describe(self, tether_length: float | None = None) -> str:
+        """The one-line description on a tether of ``tether_length`` [m] (None: the
+        reference), naming the scaling where there is one."""
+        if not self.free:
+            return self.description
+        text = _describe_start(self.env_kwargs_for(tether_length)["perturbation"])
+        k = amplitude_scale(tether_length)
+        if k != 1.0:
+            text += (f" (the {REFERENCE_TETHER_LENGTH:g} m reference's displacements x {k:.3g} "
+                     f"for the {tether_length:g} m tether)")
+        return text
+
 
 _D = 10.0 / math.sqrt(2.0)  # 7.07 m: a 10 m swing at 45 degrees
 SCENARIOS = {
-    "recover": Scenario(_recover(10.0, 0.0, 0.05), 180.0,
-                        "calm, 10 m along-wind swing + 0.05 rad pitch", ("x",)),
-    "recover_small": Scenario(_recover(1.0, 0.0, 0.005), 180.0,
-                              "calm, 1 m along-wind swing + 0.005 rad pitch", ("x",)),
-    "recover_cross": Scenario(_recover(0.0, 10.0, 0.05), 180.0,
-                              "calm, 10 m cross-wind swing + 0.05 rad pitch", ("y",)),
-    "recover_cross_small": Scenario(_recover(0.0, 1.0, 0.005), 180.0,
-                                    "calm, 1 m cross-wind swing + 0.005 rad pitch", ("y",)),
-    "recover_combined": Scenario(_recover(_D, _D, 0.05), 180.0,
-                                 "calm, 7.07 m along + 7.07 m across + 0.05 rad pitch",
-                                 ("x", "y")),
+    "recover": Scenario(_recover(10.0, 0.0, 0.05), 180.0, pendulums=("x",)),
+    "recover_small": Scenario(_recover(1.0, 0.0, 0.005), 180.0, pendulums=("x",)),
+    "recover_cross": Scenario(_recover(0.0, 10.0, 0.05), 180.0, pendulums=("y",)),
+    "recover_cross_small": Scenario(_recover(0.0, 1.0, 0.005), 180.0, pendulums=("y",)),
+    "recover_combined": Scenario(_recover(_D, _D, 0.05), 180.0, pendulums=("x", "y")),
     "recover_combined_small": Scenario(_recover(_D / 10, _D / 10, 0.005), 180.0,
-                                       "calm, 0.707 m along + 0.707 m across + 0.005 rad pitch",
-                                       ("x", "y")),
+                                       pendulums=("x", "y")),
     "gusty_light": Scenario({"turbulence": "light", "perturbation": "none"}, 120.0,
                             "light turbulence (sigma_u/U = 5 %), no perturbation"),
     "gusty": Scenario({"turbulence": "moderate", "perturbation": "none"}, 120.0,
@@ -203,15 +248,22 @@ def held_suite_speeds(name: str, params=None) -> list | None:
     return [u for u in us if u <= top] or [top]
 
 
-def describe_suite(name: str, speeds=None) -> str:
+def tether_length_of(params) -> float | None:
+    """The tether length [m] of ``params`` (a Params, a TOML path or a shipped configuration's
+    name), None for the baseline (None)."""
+    return None if params is None else as_params(params).tether.length
+
+
+def describe_suite(name: str, speeds=None, tether_length: float | None = None) -> str:
     """One line per scenario of a suite (at ``speeds`` if given, see :func:`suite_cells`): wind
-    speeds, seeds (as ranges) and description."""
+    speeds, seeds (as ranges) and description (on a tether of ``tether_length`` [m], None: the
+    reference)."""
     lines = []
     for scenario, (us, seeds) in suite_cells(name, speeds).items():
         s = sorted(seeds)
         span = (f"{s[0]}-{s[-1]}" if len(s) > 2 and s == list(range(s[0], s[-1] + 1))
                 else ", ".join(map(str, s)))
-        lines.append(f"- `{scenario}` ({SCENARIOS[scenario].description}, "
+        lines.append(f"- `{scenario}` ({SCENARIOS[scenario].describe(tether_length)}, "
                      f"{SCENARIOS[scenario].duration:g} s): U = "
                      f"{', '.join(f'{u:g}' for u in us)} m/s; seeds {span}")
     noise = SUITE_OBS_NOISE.get(name, 0.0)
@@ -247,8 +299,13 @@ def check_suite(name: str) -> dict:
 
 
 def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2,
-                 env_kwargs: dict | None = None) -> Episodes:
+                 env_kwargs: dict | None = None, displacement_scale: float | None = None
+                 ) -> Episodes:
     """Run ``policy`` on every (speed, seed) pair of a scenario in one batched environment.
+
+    A free response's displacements are the reference tether's times the tether's
+    :func:`amplitude_scale`, or times ``displacement_scale`` where given (1.0: the stated
+    metres on any tether).
 
     The environment's wind-speed range is the training range DEFAULT_WIND_RANGE widened to
     the requested speeds (so the suites inside it run on exactly the training environment's
@@ -259,9 +316,10 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     sc = SCENARIOS[scenario]
     pairs = [(u, s) for u in speeds for s in seeds]
     steps = int(round(sc.duration / check_control_step(control_step)))
-    kwargs = {"wind_speed": cells_wind_range({scenario: (speeds, seeds)},
-                                             (env_kwargs or {}).get("params")),
-              **(env_kwargs or {}), **sc.env_kwargs}
+    params = (env_kwargs or {}).get("params")
+    kwargs = {"wind_speed": cells_wind_range({scenario: (speeds, seeds)}, params),
+              **(env_kwargs or {}),
+              **sc.env_kwargs_for(tether_length_of(params), displacement_scale)}
     env = TetheredAerostatVectorEnv(num_envs=len(pairs), max_episode_steps=steps,
                                     observation="full", control_step=control_step, **kwargs)
     obs, _ = env.reset(seed=[s for _, s in pairs],

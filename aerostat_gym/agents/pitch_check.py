@@ -34,6 +34,7 @@ from .evaluate import (
     cells_wind_range,
     episode_metrics,
     run_scenario,
+    tether_length_of,
 )
 from .fit_guides import FAST_MODE_FACTOR, fit_guides, is_baseline
 from .frontier import linear_response
@@ -52,7 +53,7 @@ AWAY_START = (0.5, 1.1, 0.9)
 def scenario_start(params, wind_speed: float, scenario: str) -> np.ndarray:
     """The scenario's start as a deviation from trim (the environment's full layout)."""
     env = TetheredAerostatVectorEnv(1, wind_speed=(wind_speed, wind_speed), params=params,
-                                    **SCENARIOS[scenario].env_kwargs)
+                                    **SCENARIOS[scenario].env_kwargs_for(tether_length_of(params)))
     env.reset(seed=[0], options={"wind_speed": [wind_speed]})
     dx0 = env.batch.state[0] - env.batch.trim_state[0]
     env.close()

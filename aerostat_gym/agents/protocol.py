@@ -341,14 +341,16 @@ def aggregate_markdown(proto: dict, label=str) -> str:
     return "\n".join(lines)
 
 
-def protocol_markdown(proto: dict, reference: str = "passive") -> str:
-    """The protocol's report: one table per cell and the aggregate table."""
+def protocol_markdown(proto: dict, reference: str = "passive",
+                      tether_length: float | None = None) -> str:
+    """The protocol's report: one table per cell and the aggregate table (the scenarios
+    described on a tether of ``tether_length`` [m], None: the reference)."""
     ref = reference if reference in proto["baselines"] else (
         proto["baselines"][0] if proto["baselines"] else None)
     parts = []
     for cell in proto["cells"]:
         sc = SCENARIOS.get(cell["scenario"])
-        desc = f" ({sc.description})" if sc is not None else ""
+        desc = f" ({sc.describe(tether_length)})" if sc is not None else ""
         seeds = f"{cell['n_seeds']} seed{'' if cell['n_seeds'] == 1 else 's'}"
         parts += [f"### {cell['scenario']}, {cell['wind_speed']:g} m/s, {seeds}{desc}", "",
                   cell_markdown(cell, ref), ""]

@@ -253,7 +253,8 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
     out.mkdir(parents=True, exist_ok=True)
     parts = [f"# {title}", "", f"Command: `{command}`", "", *(preamble or []),
              f"Suite `{results[0]['suite']}` (control step 0.2 s):", "",
-             describe_suite(results[0]["suite"], results[0].get("speeds")), "",
+             describe_suite(results[0]["suite"], results[0].get("speeds"),
+                            results[0].get("tether_length_m")), "",
              "Scores (mean episode return, default reward): " +
              ", ".join(f"{r['label']} {r['score']:.0f}" for r in results) + ". " +
              score_and_damping(results), ""]
@@ -279,8 +280,10 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
         (out / "protocol.md").write_text(
             "\n".join([f"# Evaluation protocol: suite `{results[0]['suite']}`", "",
                        f"Command: `{command}`", "",
-                       describe_suite(results[0]["suite"], results[0].get("speeds")), "",
-                       proto_mod.protocol_markdown(proto)]))
+                       describe_suite(results[0]["suite"], results[0].get("speeds"),
+                            results[0].get("tether_length_m")), "",
+                       proto_mod.protocol_markdown(
+                           proto, tether_length=results[0].get("tether_length_m"))]))
         (out / "protocol.json").write_text(proto_mod.dumps(proto))
     md = out / "report.md"
     md.write_text("\n".join(parts))

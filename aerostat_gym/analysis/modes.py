@@ -12,6 +12,7 @@ changes along the nodes), as [LN02] classified its modes by eye.
 from __future__ import annotations
 
 import math
+import re
 import time
 from dataclasses import dataclass, field
 
@@ -180,6 +181,21 @@ def count_sign_changes(shape: np.ndarray, threshold: float = 0.1) -> int:
     return int(np.sum(np.signbit(big[1:]) != np.signbit(big[:-1])))
 
 
+def tether_share(energy: dict, ctx: ModeContext) -> float:
+    """The tether nodes' share of a mode's kinetic energy (transverse and axial)."""
+    return energy[ctx.transverse] + (energy[ctx.axial] if ctx.axial else 0.0)
+
+
+def tether_label(real: np.ndarray, energy: dict, ctx: ModeContext) -> tuple[str, int]:
+    """(label, k) of a mode read as a tether mode: the k-th harmonic has k - 1 sign changes
+    along the moving nodes, counted on the axial coordinate when the tether's motion is mostly
+    along it ("tether axial k"), on the transverse one otherwise ("tether k-th harmonic")."""
+    axial = ctx.axial is not None and energy[ctx.axial] > energy[ctx.transverse]
+    coord = ctx.groups[ctx.axial] if axial else ctx.tether
+    k = count_sign_changes(real[coord]) + 1
+    return (f"tether axial {k}" if axial else f"tether {ordinal(k)} harmonic"), k
+
+
 def classify(vector: np.ndarray, ctx: ModeContext) -> tuple[str, dict, np.ndarray, int]:
     """Name a mode from its eigenvector.
 
@@ -203,12 +219,8 @@ def classify(vector: np.ndarray, ctx: ModeContext) -> tuple[str, dict, np.ndarra
     energy = {g: float(np.sum(e[idx])) / total for g, idx in ctx.groups.items()}
     real = _realify(v)
     shape = np.concatenate([[0.0], real[ctx.tether][::-1], [real @ ctx.top]])
-    tether_share = energy[ctx.transverse] + (energy[ctx.axial] if ctx.axial else 0.0)
-    if tether_share > 0.5:
-        axial = ctx.axial is not None and energy[ctx.axial] > energy[ctx.transverse]
-        coord = ctx.groups[ctx.axial] if axial else ctx.tether
-        k = count_sign_changes(real[coord]) + 1
-        label = f"tether axial {k}" if axial else f"tether {ordinal(k)} harmonic"
+    if tether_share(energy, ctx) > 0.5:
+        label, k = tether_label(real, energy, ctx)
         return label, energy, shape, k - 1
     names = ({"aerostat_x": "pendulum", "aerostat_z": "axial spring", "pitch": "pitching"}
              if ctx.subset == "long" else
@@ -242,7 +254,7 @@ def modal_table(A_sub: np.ndarray, ctx: ModeContext) -> list[Mode]:
     3 n + 3 modes for the 6 n + 6 states, real eigenvalues counted in pairs.
     """
     modes = modes_from_eig(*np.linalg.eig(A_sub), ctx)
-    resolve_duplicates(modes, ctx.subset)
+    resolve_duplicates(modes, ctx)
     return modes
 
 
@@ -271,25 +283,89 @@ AEROSTAT_MODES = {
 }
 
 
-def resolve_duplicates(modes: list[Mode], subset: str) -> None:
-    """Give each missing aerostat mode to the duplicate-labelled mode that carries most of it.
+#: A mode that loses a repeated aerostat label is renamed as a tether mode only if the tether
+#: carries at least this share of its kinetic energy (else the repeat is kept, as no name fits).
+TETHER_SHARE_TO_RENAME = 0.2
+
+
+def resolve_duplicates(modes: list[Mode], ctx: ModeContext) -> None:
+    """Make each aerostat mode's label unique within a set (in place).
 
     Notes
     -----
-    Each of the aerostat's modes exists once per set. When coupling hides one (in wind the
-    lateral yaw mode sways the aerostat with the tether, so its largest energy share is y like
-    the pendulum's; at zero wind rolling and the first lateral tether harmonic share energy
-    about equally), two modes get the same label and one label is missing. The mode with the
-    largest energy share in the missing mode's group, among those with a repeated label,
-    takes the missing label (in place).
+    Each of the aerostat's modes exists once per set, but near a frequency crossing the
+    aerostat's and the tether's modes mix, so that two modes have the same largest aerostat
+    share. Two passes:
+
+    * a missing aerostat label goes to the duplicate-labelled mode that carries most of its
+      group (in wind the lateral yaw mode sways the aerostat with the tether, so its largest
+      share is y like the pendulum's; at zero wind rolling and the first lateral tether harmonic
+      share energy about equally);
+    * an aerostat label still held by several oscillatory modes stays with the one that carries
+      most of its group; the others are the tether modes they mix with (e.g. the TCOM 32M at
+      6-9 m/s: pitching and the first tether harmonic, both 40-50 % pitch, 40-50 % tether), and
+      are named by their tether shape when the tether carries at least
+      :data:`TETHER_SHARE_TO_RENAME` of their energy and that tether label is free.
+
+    Two real eigenvalues with one label (zero-wind yaw) are one mode and keep it.
     """
-    for label, group in AEROSTAT_MODES[subset].items():
+    for label, group in AEROSTAT_MODES[ctx.subset].items():
         labels = [m.label for m in modes]
         if label in labels:
             continue
         dup = [m for m in modes if labels.count(m.label) > 1 and m.energy[group] > 0.05]
         if dup:
             max(dup, key=lambda m: m.energy[group]).label = label
+    for label, group in AEROSTAT_MODES[ctx.subset].items():
+        held = [m for m in modes if m.label == label and m.oscillatory]
+        if len(held) < 2:
+            continue
+        keeper = max(held, key=lambda m: m.energy[group])
+        for m in held:
+            if m is keeper or tether_share(m.energy, ctx) < TETHER_SHARE_TO_RENAME:
+                continue
+            name, k = tether_label(_realify(m.vector[ctx.pos]), m.energy, ctx)
+            if all(other.label != name for other in modes):
+                m.label, m.sign_changes = name, k - 1
+    _fill_harmonic_gaps(modes)
+
+
+_HARMONIC = re.compile(r"tether (?:(\d+)(?:st|nd|rd|th) harmonic|axial (\d+))$")
+
+
+def _harmonic(label: str) -> tuple[str, int] | None:
+    """(family, number) of a tether label ("transverse" or "axial"), None for another label."""
+    m = _HARMONIC.match(label)
+    if m is None:
+        return None
+    return ("transverse", int(m[1])) if m[1] else ("axial", int(m[2]))
+
+
+def _fill_harmonic_gaps(modes: list[Mode]) -> None:
+    """Give a repeated tether harmonic's number to a missing neighbour (in place).
+
+    Where the aerostat pitches with the first tether harmonic, the tether's shape under the
+    confluence point can change sign once more, and the mode counts as the second harmonic
+    beside the true one (3.5 x the baseline on 556 m: 3.10 s and 1.68 s, the closed form's
+    first harmonic 3.38 s). Of two oscillatory modes with one number, the longer-period one
+    takes the nearest missing lower number, or else the shorter-period one the nearest missing
+    higher number (a harmonic's number grows as its period shrinks).
+    """
+    osc = [m for m in modes if m.oscillatory and _harmonic(m.label)]
+    for family in ("transverse", "axial"):
+        fam = [m for m in osc if _harmonic(m.label)[0] == family]
+        for _ in range(len(fam)):
+            numbers = [_harmonic(m.label)[1] for m in fam]
+            repeated = sorted({k for k in numbers if numbers.count(k) > 1})
+            if not repeated:
+                break
+            k = repeated[0]
+            held = sorted((m for m in fam if _harmonic(m.label)[1] == k), key=lambda m: m.wn)
+            lower = [j for j in range(1, k) if j not in numbers]
+            higher = [j for j in range(k + 1, max(numbers) + 2) if j not in numbers]
+            m, j = (held[0], lower[-1]) if lower else (held[-1], higher[0])
+            m.label = f"tether {ordinal(j)} harmonic" if family == "transverse" else f"tether axial {j}"
+            m.sign_changes = j - 1
 
 
 def count_modes(modes: list[Mode]) -> float:
