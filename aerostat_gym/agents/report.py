@@ -251,10 +251,10 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
     ``preamble``: Markdown lines placed after the command line (e.g. the demo's summary)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    tether_length = results[0].get("tether_length_m")
+    suite_lines = describe_suite(results[0]["suite"], results[0].get("speeds"), tether_length)
     parts = [f"# {title}", "", f"Command: `{command}`", "", *(preamble or []),
-             f"Suite `{results[0]['suite']}` (control step 0.2 s):", "",
-             describe_suite(results[0]["suite"], results[0].get("speeds"),
-                            results[0].get("tether_length_m")), "",
+             f"Suite `{results[0]['suite']}` (control step 0.2 s):", "", suite_lines, "",
              "Scores (mean episode return, default reward): " +
              ", ".join(f"{r['label']} {r['score']:.0f}" for r in results) + ". " +
              score_and_damping(results), ""]
@@ -280,10 +280,7 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
         (out / "protocol.md").write_text(
             "\n".join([f"# Evaluation protocol: suite `{results[0]['suite']}`", "",
                        f"Command: `{command}`", "",
-                       describe_suite(results[0]["suite"], results[0].get("speeds"),
-                            results[0].get("tether_length_m")), "",
-                       proto_mod.protocol_markdown(
-                           proto, tether_length=results[0].get("tether_length_m"))]))
+                       suite_lines, "", proto_mod.protocol_markdown(proto, tether_length=tether_length)]))
         (out / "protocol.json").write_text(proto_mod.dumps(proto))
     md = out / "report.md"
     md.write_text("\n".join(parts))

@@ -186,6 +186,11 @@ def tether_share(energy: dict, ctx: ModeContext) -> float:
     return energy[ctx.transverse] + (energy[ctx.axial] if ctx.axial else 0.0)
 
 
+def tether_name(axial: bool, k: int) -> str:
+    """The label of the k-th tether mode: "tether axial k" or "tether k-th harmonic"."""
+    return f"tether axial {k}" if axial else f"tether {ordinal(k)} harmonic"
+
+
 def tether_label(real: np.ndarray, energy: dict, ctx: ModeContext) -> tuple[str, int]:
     """(label, k) of a mode read as a tether mode: the k-th harmonic has k - 1 sign changes
     along the moving nodes, counted on the axial coordinate when the tether's motion is mostly
@@ -193,7 +198,7 @@ def tether_label(real: np.ndarray, energy: dict, ctx: ModeContext) -> tuple[str,
     axial = ctx.axial is not None and energy[ctx.axial] > energy[ctx.transverse]
     coord = ctx.groups[ctx.axial] if axial else ctx.tether
     k = count_sign_changes(real[coord]) + 1
-    return (f"tether axial {k}" if axial else f"tether {ordinal(k)} harmonic"), k
+    return tether_name(axial, k), k
 
 
 def classify(vector: np.ndarray, ctx: ModeContext) -> tuple[str, dict, np.ndarray, int]:
@@ -364,8 +369,7 @@ def _fill_harmonic_gaps(modes: list[Mode]) -> None:
             lower = [j for j in range(1, k) if j not in numbers]
             higher = [j for j in range(k + 1, max(numbers) + 2) if j not in numbers]
             m, j = (held[0], lower[-1]) if lower else (held[-1], higher[0])
-            m.label = f"tether {ordinal(j)} harmonic" if family == "transverse" else f"tether axial {j}"
-            m.sign_changes = j - 1
+            m.label, m.sign_changes = tether_name(family == "axial", j), j - 1
 
 
 def count_modes(modes: list[Mode]) -> float:
