@@ -21,6 +21,7 @@ import gymnasium as gym
 import numpy as np
 
 import aerostat_gym  # noqa: F401  (registers the environment)
+from aerostat_gym.bench.soak import STRESS_PERTURBATION
 from aerostat_gym.envs.batch import held_wind_top
 from aerostat_gym.params import TETHER_DRAG_REFERENCE_SPEED, load_params, tether_drag_step
 from aerostat_gym.registration import ENV_ID
@@ -43,7 +44,8 @@ def run(p, seed: int) -> tuple[Counter, tuple[float, float]]:
     winds = (max(3.0, top - SPAN), top)
     counts = Counter()
     env = gym.make_vec(ENV_ID, num_envs=N_ENVS, vectorization_mode="vector_entry_point",
-                       params=p, wind_speed=winds, turbulence="severe", randomize=True)
+                       params=p, wind_speed=winds, turbulence="severe", randomize=True,
+                       perturbation=STRESS_PERTURBATION)
     env.reset(seed=seed)
     rng = np.random.default_rng(seed)
     for _ in range(STEPS):

@@ -21,6 +21,7 @@ import gymnasium as gym
 import numpy as np
 
 import aerostat_gym  # noqa: F401  (registers the environment)
+from aerostat_gym.bench.soak import STRESS_PERTURBATION
 from aerostat_gym.registration import ENV_ID
 
 N_ENVS, STEPS = 8, 600
@@ -32,7 +33,7 @@ def episode_ends(length: float, elements: int, wind: float, overrides: dict) -> 
     for braked in (False, True):
         env = gym.make_vec(ENV_ID, num_envs=N_ENVS, vectorization_mode="vector_entry_point",
                            tether_length=length, n_elements=elements, wind_speed=wind,
-                           turbulence="severe",
+                           turbulence="severe", perturbation=STRESS_PERTURBATION,
                            overrides={"winch.min_length": min(30.0, length), **overrides})
         env.reset(seed=0)
         rng = np.random.default_rng(0)

@@ -55,7 +55,13 @@ from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main
 from aerostat_gym.cli.stability import held_speeds
 from aerostat_gym.envs.batch import held_wind_top
-from aerostat_gym.envs.config import TaskError
+from aerostat_gym.envs.config import (
+    PERTURBATIONS,
+    REFERENCE_TETHER_LENGTH,
+    TaskConfig,
+    TaskError,
+    displacement_scale,
+)
 from aerostat_gym.envs.episodes import TrimTable
 from aerostat_gym.params import (
     SEMI_IMPLICIT_REFERENCE_DT,
@@ -438,6 +444,34 @@ def test_env_episodes_on_configured_params(case):
             assert not term, info
             done = trunc
     env.close()
+
+
+def test_perturbation_presets_scale_with_the_tether():
+    """A named perturbation preset's swing and lateral displacement are stated for the 300 m
+    reference tether and scale with the configured one (0.05 x the volume on 60 m: x 0.2, so
+    the same 1.9 deg swing angle per 10 m of the reference's swing), at construction and as a
+    reset option; the pitch kick (an angle) is kept, a dict is taken in metres, and on the
+    baseline the presets are exactly the table's."""
+    assert REFERENCE_TETHER_LENGTH == load_params().tether.length
+    base = TaskConfig(perturbation="mixed", turbulence="none")
+    assert {k: base.resolved["perturbation"][k] for k in PERTURBATIONS["mixed"]} == \
+        PERTURBATIONS["mixed"]
+    small = scale_aerostat(load_params(), 0.05, 60.0)
+    assert displacement_scale(small.tether.length) == pytest.approx(0.2, rel=1e-15)
+    draws = {}
+    for name, params in (("base", None), ("small", small)):
+        env = gym.make(ENV_ID, params=params, turbulence="none", perturbation="displacement",
+                       wind_speed=10.0)
+        infos = [env.reset(seed=3)[1], env.reset(seed=3, options={"perturbation": "mixed"})[1],
+                 env.reset(seed=3, options={"perturbation": {"swing": 10.0}})[1]]
+        draws[name] = [(i["swing_m"], i["lateral_m"], i["pitch_rad"]) for i in infos]
+        env.close()
+    for (sb, lb, pb), (ss, ls, ps) in zip(draws["base"][:2], draws["small"][:2], strict=True):
+        assert abs(sb) > 1.0 and abs(lb) > 0.5  # a real draw, not a zero
+        assert ss == pytest.approx(0.2 * sb, rel=1e-12)
+        assert ls == pytest.approx(0.2 * lb, rel=1e-12)
+        assert ps == pb  # the pitch kick is an angle: unscaled
+    assert draws["small"][2][0] == draws["base"][2][0]  # a dict's metres are kept
 
 
 def lqr_damping_check(p, wind=10.0, periods=3.0):

@@ -19,7 +19,8 @@ the confluence point, :func:`aerostat_gym.envs.episodes._perturb`):
   displacement, pitch and pitch rate, tension, length wander, winch energy.
 
 The recover scenarios' displacements are stated for the baseline's 300 m tether
-(:data:`REFERENCE_TETHER_LENGTH`); on another tether they scale with its length, so that every
+(:data:`~aerostat_gym.envs.config.REFERENCE_TETHER_LENGTH`, as the environment's
+perturbation presets are); on another tether they scale with its length, so that every
 aerostat is swung through the same angle (1.9 degrees for the 10 m swing), and the reports say
 so in each scenario's description.
 
@@ -49,7 +50,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..envs.batch import held_wind_top
-from ..envs.config import DEFAULT_WIND_RANGE, check_control_step
+from ..envs.config import (
+    DEFAULT_WIND_RANGE,
+    REFERENCE_TETHER_LENGTH,
+    check_control_step,
+    displacement_scale,
+)
 from ..envs.spaces import N_OBS
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import Params, as_params, dumps_toml
@@ -64,20 +70,6 @@ from .sb3io import PolicyError
 #: (passive ignores them; tension feedback, LQG and learned policies do); the privileged LQR
 #: and modal controllers read the appended full state, which carries no noise.
 SENSOR_NOISE = 0.01
-
-
-#: The tether length [m] the recover scenarios' displacements are stated for: the baseline's.
-#: On another tether they scale with its length (:meth:`Scenario.env_kwargs_for`), so that the
-#: swing turns the tether through the same angle (10 m on 300 m: 1.9 degrees, where 10 m on a
-#: 30 m tether would be 19 degrees, far outside the linear regime the fits assume); the pitch
-#: kick is an angle and is kept.
-REFERENCE_TETHER_LENGTH = 300.0
-
-
-def amplitude_scale(tether_length: float | None) -> float:
-    """Factor on the recover scenarios' displacements for a tether of ``tether_length`` [m]
-    (None: the reference, factor 1)."""
-    return 1.0 if tether_length is None else float(tether_length) / REFERENCE_TETHER_LENGTH
 
 
 def _recover(along: float, lateral: float, pitch: float) -> dict:
@@ -114,11 +106,11 @@ class Scenario:
                        scale: float | None = None) -> dict:
         """The environment keyword arguments on a tether of ``tether_length`` [m] (None: the
         reference): a free response's swing and cross-wind displacement times ``scale``
-        (default :func:`amplitude_scale` of the tether)."""
+        (default :func:`displacement_scale` of the tether)."""
         if not self.free:
             return dict(self.env_kwargs)
         pert = self.env_kwargs["perturbation"]
-        k = amplitude_scale(tether_length) if scale is None else float(scale)
+        k = displacement_scale(tether_length) if scale is None else float(scale)
         return {**self.env_kwargs,
                 "perturbation": {**pert, "swing": pert["swing"] * k, "lateral": pert["lateral"] * k}}
 
@@ -128,7 +120,7 @@ class Scenario:
         if not self.free:
             return self.description
         text = _describe_start(self.env_kwargs_for(tether_length)["perturbation"])
-        k = amplitude_scale(tether_length)
+        k = displacement_scale(tether_length)
         if k != 1.0:
             text += (f" (the {REFERENCE_TETHER_LENGTH:g} m reference's displacements x {k:.3g} "
                      f"for the {tether_length:g} m tether)")
@@ -304,7 +296,7 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     """Run ``policy`` on every (speed, seed) pair of a scenario in one batched environment.
 
     A free response's displacements are the reference tether's times the tether's
-    :func:`amplitude_scale`, or times ``displacement_scale`` where given (1.0: the stated
+    :func:`displacement_scale`, or times ``displacement_scale`` where given (1.0: the stated
     metres on any tether).
 
     The environment's wind-speed range is the training range DEFAULT_WIND_RANGE widened to

@@ -34,6 +34,8 @@ from .spaces import check_obs_noise
 #: (a rigid rotation of aerostat and tether about the winch), pitch kick about the confluence
 #: point [rad], and a 1 - cos gust along the wind drawn with this probability. Amplitudes are
 #: drawn uniformly in [-max, max]; with "fixed": True they are applied as given (signed).
+#: A preset's displacements are stated for a tether of :data:`REFERENCE_TETHER_LENGTH` and
+#: scale with the configured tether (:func:`displacement_scale`); a dict is taken in metres.
 PERTURBATIONS = {
     "none": {"swing": 0.0, "lateral": 0.0, "pitch": 0.0, "gust_probability": 0.0,
              "fixed": False},
@@ -41,6 +43,12 @@ PERTURBATIONS = {
     "gust": {"swing": 0.0, "lateral": 0.0, "pitch": 0.0, "gust_probability": 1.0},
     "mixed": {"swing": 10.0, "lateral": 5.0, "pitch": 0.05, "gust_probability": 0.5},
 }
+#: The tether length [m] the presets' displacements are stated for (the baseline's). On another
+#: tether a preset's swing and lateral displacement scale with its length, so that every
+#: aerostat is swung through the same angle about the winch (10 m on 300 m: 1.9 degrees, where
+#: 10 m on a 30 m tether would be 19 degrees, far outside the linear regime the task's
+#: controllers and the evaluator's fits assume); the pitch kick is an angle and is kept.
+REFERENCE_TETHER_LENGTH = 300.0
 GUST_DEFAULTS = {"gust_amplitude": (1.0, 4.0), "gust_duration": (5.0, 20.0),
                  "gust_onset": (0.0, 30.0)}
 #: Estimated parameters randomised by ``randomize=True`` (relative half-ranges).
@@ -56,6 +64,12 @@ DEFAULT_WIND_RANGE = (3.0, 15.0)
 
 class TaskError(ValueError):
     """An invalid environment argument (the message names it and the value)."""
+
+
+def displacement_scale(tether_length: float | None) -> float:
+    """Factor on stated swing and lateral displacements for a tether of ``tether_length`` [m]
+    (None: the reference, factor 1): ``tether_length`` / :data:`REFERENCE_TETHER_LENGTH`."""
+    return 1.0 if tether_length is None else float(tether_length) / REFERENCE_TETHER_LENGTH
 
 
 def _range(name, value, lo_min=0.0, hi_max=math.inf):
@@ -122,7 +136,7 @@ class TaskConfig:
     def __post_init__(self):
         r = self.resolved
         r["wind_speed"] = _range("wind_speed", self.wind_speed, hi_max=MAX_WIND_SPEED)
-        r["perturbation"] = perturbation(self.perturbation)
+        perturbation(self.perturbation)  # named at the door, before the parameters load
         if self.integrator not in INTEGRATORS:
             raise TaskError(f"unknown integrator {self.integrator!r}; choose one of {INTEGRATORS}")
         check_control_step(self.control_step)
@@ -140,6 +154,7 @@ class TaskConfig:
         if not is_whole(self.wind_bank_seed, 0):  # the bank is part of the task: never drawn afresh
             raise TaskError(f"wind_bank_seed must be an integer >= 0, got {self.wind_bank_seed!r}")
         r["params"] = self._params()
+        r["perturbation"] = perturbation(self.perturbation, r["params"].tether.length)
         try:  # the field's heights and extent follow the configured aerostat, tether and winch
             r["turbulence"] = sized_turbulence(r["params"], self.turbulence)
         except (TypeError, ValueError) as exc:
@@ -240,13 +255,18 @@ def get_parameter(params: Params, key: str):
     return getattr(getattr(params, sec), name)
 
 
-def perturbation(spec) -> dict:
-    """A validated perturbation dict from a preset name or a (partial) dict."""
+def perturbation(spec, tether_length: float | None = None) -> dict:
+    """A validated perturbation dict from a preset name or a (partial) dict. A preset's swing
+    and lateral displacement are scaled to a tether of ``tether_length`` [m]
+    (:func:`displacement_scale`; None: as stated, for the reference tether); a dict's are
+    taken as given, in metres."""
     if isinstance(spec, str):
         if spec not in PERTURBATIONS:
             raise TaskError(f"unknown perturbation {spec!r}; choose one of {list(PERTURBATIONS)}"
                             " or pass a dict")
-        spec = PERTURBATIONS[spec]
+        k = displacement_scale(tether_length)
+        spec = {**PERTURBATIONS[spec]}
+        spec.update(swing=spec["swing"] * k, lateral=spec["lateral"] * k)
     if not isinstance(spec, dict):
         raise TaskError(f"perturbation must be a preset name or a dict, got {spec!r}")
     out = {**PERTURBATIONS["none"], **GUST_DEFAULTS}

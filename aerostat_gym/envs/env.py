@@ -152,7 +152,10 @@ class TetheredAerostatEnv(gym.Env):
       fields keep its length scales, which the classes share.
     - ``perturbation="mixed"``: "none", "displacement", "gust", "mixed" or a dict with keys
       swing [m], lateral [m], pitch [rad], gust_probability, gust_amplitude [m/s] (low, high),
-      gust_duration [s] (low, high), gust_onset [s] (low, high).
+      gust_duration [s] (low, high), gust_onset [s] (low, high). A preset's swing and lateral
+      displacement are stated for a 300 m tether and scale with the configured one (the same
+      swing angle on every aerostat; ``aerostat_gym.envs.config.displacement_scale``); a
+      dict's are taken in metres.
     - ``tether_length=None`` [m] and ``n_elements=None``: override the parameter file.
     - ``integrator="semi-implicit"`` or ``"rk4"`` (the reference; about 7x slower).
     - ``control_step=0.2`` [s]: 220 steps per pendulum period (~44 s), ~15 per axial-spring
@@ -233,6 +236,10 @@ class TetheredAerostatEnv(gym.Env):
       integer >= 0 (a NumPy TypeError before); ``overrides``, ``reward_weights`` and the reset
       options must be mappings (TypeErrors before); ``wind_speed`` is capped at 100 m/s, where
       the incompressible aerodynamics end (1e300 hung the trim table).
+    - v0 (aerostat-gym 0.7.10; the registered tasks on the baseline's 300 m tether, the
+      dynamics, observation and reward unchanged): a perturbation preset's swing and lateral
+      displacement scale with the configured tether's length over 300 m (were 10 m and 5 m on
+      every tether: 10 deg of swing on a 60 m tether); a dict is still taken in metres.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}

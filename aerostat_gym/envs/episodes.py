@@ -164,8 +164,8 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
     unknown = sorted(set(opts) - {"wind_speed", "perturbation"})
     if unknown:
         raise TaskError(f"unknown reset option(s) {unknown}; known: ['perturbation', 'wind_speed']")
-    pert = perturbation(opts["perturbation"]) if "perturbation" in opts else \
-        task.resolved["perturbation"]
+    pert = (perturbation(opts["perturbation"], trims.params.tether.length)
+            if "perturbation" in opts else task.resolved["perturbation"])
     k = _speed_index(trims, opts.get("wind_speed"), rng)
     U = float(trims.speeds[k])
     params, x_trim = _parameters(task, trims, k, rng)
