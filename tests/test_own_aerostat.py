@@ -55,14 +55,9 @@ from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main
 from aerostat_gym.cli.stability import held_speeds
 from aerostat_gym.envs.batch import held_wind_top
-from aerostat_gym.envs.config import (
-    PERTURBATIONS,
-    REFERENCE_TETHER_LENGTH,
-    TaskConfig,
-    TaskError,
-    displacement_scale,
-)
+from aerostat_gym.envs.config import PERTURBATIONS, TaskConfig, TaskError
 from aerostat_gym.envs.episodes import TrimTable
+from aerostat_gym.envs.spaces import REFERENCE_TETHER_LENGTH, displacement_scale
 from aerostat_gym.params import (
     SEMI_IMPLICIT_REFERENCE_DT,
     SEMI_IMPLICIT_REFERENCE_HULL_LENGTH,
@@ -472,6 +467,41 @@ def test_perturbation_presets_scale_with_the_tether():
         assert ls == pytest.approx(0.2 * lb, rel=1e-12)
         assert ps == pb  # the pitch kick is an angle: unscaled
     assert draws["small"][2][0] == draws["base"][2][0]  # a dict's metres are kept
+
+
+def test_reward_swing_terms_are_sized_by_the_tether():
+    """The default reward's swing weights follow the tether (reward.sized_weights, k = L / 300
+    m): displacement and length / k^2, velocity / k, the rest unchanged; exactly the defaults
+    on the baseline. The compiled terms equal those formulas on the step's observation
+    (float32 channels: rel 1e-6), and the same-angle preset start then scores its swing alike
+    on 0.05 x the volume on 60 m and 8 x on 1000 m (measured -0.865 and -0.792 against the
+    baseline's -0.815, within 10 %; with the baseline's weights they would read -0.035 and
+    -8.8)."""
+    from aerostat_gym.envs.reward import DEFAULT_WEIGHTS, reward_table
+    from aerostat_gym.envs.spaces import OBS_DX, OBS_DY, OBS_VX, OBS_VY
+
+    assert {r["term"]: r["weight"] for r in reward_table(tether_length=300.0)} == DEFAULT_WEIGHTS
+    sized = {r["term"]: r["weight"] for r in reward_table(tether_length=60.0)}
+    assert sized == pytest.approx({**DEFAULT_WEIGHTS, "displacement": 25.0, "velocity": 5.0,
+                                   "length": 25.0}, rel=1e-12)
+    terms = {}
+    for params in (None, scale_aerostat(load_params(), 0.05, 60.0),
+                   scale_aerostat(load_params(), 8.0, 1000.0)):
+        env = gym.make(ENV_ID, params=params, turbulence="none", perturbation="displacement",
+                       wind_speed=10.0)
+        k = displacement_scale(env.unwrapped.task.params_resolved.tether.length)
+        env.reset(seed=3)
+        obs, _, _, _, info = env.step(np.zeros(1, np.float32))
+        env.close()
+        disp = -float(obs[OBS_DX] ** 2 + obs[OBS_DY] ** 2) / k**2
+        vel = -float(obs[OBS_VX] ** 2 + obs[OBS_VY] ** 2) / k
+        assert info["reward_displacement"] == pytest.approx(disp, rel=1e-6)
+        assert info["reward_velocity"] == pytest.approx(vel, rel=1e-6)
+        terms[k] = info["reward_displacement"]
+    base = terms[1.0]
+    assert base < -0.5  # a real swing
+    for k, term in terms.items():
+        assert term == pytest.approx(base, rel=0.10), (k, term)
 
 
 def lqr_damping_check(p, wind=10.0, periods=3.0):

@@ -19,7 +19,7 @@ the confluence point, :func:`aerostat_gym.envs.episodes._perturb`):
   displacement, pitch and pitch rate, tension, length wander, winch energy.
 
 The recover scenarios' displacements are stated for the baseline's 300 m tether
-(:data:`~aerostat_gym.envs.config.REFERENCE_TETHER_LENGTH`, as the environment's
+(:data:`~aerostat_gym.envs.spaces.REFERENCE_TETHER_LENGTH`, as the environment's
 perturbation presets are); on another tether they scale with its length, so that every
 aerostat is swung through the same angle (1.9 degrees for the 10 m swing), and the reports say
 so in each scenario's description.
@@ -50,13 +50,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..envs.batch import held_wind_top
-from ..envs.config import (
-    DEFAULT_WIND_RANGE,
-    REFERENCE_TETHER_LENGTH,
-    check_control_step,
-    displacement_scale,
-)
-from ..envs.spaces import N_OBS
+from ..envs.config import DEFAULT_WIND_RANGE, check_control_step
+from ..envs.spaces import N_OBS, REFERENCE_TETHER_LENGTH, displacement_scale
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import Params, as_params, dumps_toml
 from .fit_guides import guide_kwargs, guides_for, screen_fits

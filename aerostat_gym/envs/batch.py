@@ -172,7 +172,7 @@ class EnvBatch:
         cfg[K.C_FULL] = 1.0 if self.full_size else 0.0
         cfg[K.C_HORIZON] = math.inf  # the periodic field serves any episode length
         cfg[K.C_FMAX] = w.max_motor_force
-        cfg[K.C_WEIGHTS:] = t.resolved["weights"]
+        cfg[K.C_WEIGHTS:] = reward.sized_weights(t.resolved["weights"], params.tether.length)
         cfg[K.C_LENGTH_BAND] = (reward.LENGTH_BAND_FRACTION * params.tether.length
                                 / spaces.CHANNELS[spaces.OBS_DLENGTH].scale)
         return cfg

@@ -28,13 +28,14 @@ from ..sim import INTEGRATORS
 from ..wind.presets import INTENSITY_CLASSES
 from ..wind.sizing import sized_turbulence
 from . import reward
-from .spaces import check_obs_noise
+from .spaces import check_obs_noise, displacement_scale
 
 #: Perturbation presets: maximum along-wind swing and lateral displacement of the aerostat [m]
 #: (a rigid rotation of aerostat and tether about the winch), pitch kick about the confluence
 #: point [rad], and a 1 - cos gust along the wind drawn with this probability. Amplitudes are
 #: drawn uniformly in [-max, max]; with "fixed": True they are applied as given (signed).
-#: A preset's displacements are stated for a tether of :data:`REFERENCE_TETHER_LENGTH` and
+#: A preset's displacements are stated for a tether of
+#: :data:`~aerostat_gym.envs.spaces.REFERENCE_TETHER_LENGTH` and
 #: scale with the configured tether (:func:`displacement_scale`); a dict is taken in metres.
 PERTURBATIONS = {
     "none": {"swing": 0.0, "lateral": 0.0, "pitch": 0.0, "gust_probability": 0.0,
@@ -43,12 +44,6 @@ PERTURBATIONS = {
     "gust": {"swing": 0.0, "lateral": 0.0, "pitch": 0.0, "gust_probability": 1.0},
     "mixed": {"swing": 10.0, "lateral": 5.0, "pitch": 0.05, "gust_probability": 0.5},
 }
-#: The tether length [m] the presets' displacements are stated for (the baseline's). On another
-#: tether a preset's swing and lateral displacement scale with its length, so that every
-#: aerostat is swung through the same angle about the winch (10 m on 300 m: 1.9 degrees, where
-#: 10 m on a 30 m tether would be 19 degrees, far outside the linear regime the task's
-#: controllers and the evaluator's fits assume); the pitch kick is an angle and is kept.
-REFERENCE_TETHER_LENGTH = 300.0
 GUST_DEFAULTS = {"gust_amplitude": (1.0, 4.0), "gust_duration": (5.0, 20.0),
                  "gust_onset": (0.0, 30.0)}
 #: Estimated parameters randomised by ``randomize=True`` (relative half-ranges).
@@ -64,12 +59,6 @@ DEFAULT_WIND_RANGE = (3.0, 15.0)
 
 class TaskError(ValueError):
     """An invalid environment argument (the message names it and the value)."""
-
-
-def displacement_scale(tether_length: float | None) -> float:
-    """Factor on stated swing and lateral displacements for a tether of ``tether_length`` [m]
-    (None: the reference, factor 1): ``tether_length`` / :data:`REFERENCE_TETHER_LENGTH`."""
-    return 1.0 if tether_length is None else float(tether_length) / REFERENCE_TETHER_LENGTH
 
 
 def _range(name, value, lo_min=0.0, hi_max=math.inf):

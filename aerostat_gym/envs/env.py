@@ -95,7 +95,10 @@ class TetheredAerostatEnv(gym.Env):
     peak element tension over the step and the winch's safe working load; termination ``-w``
     on a terminating step; length ``-w max(0, |dlength| - band)^2`` (channel 14, band 5 % of
     the tether length: the length may wander 15 m for free on the baseline). Defaults:
-    ``aerostat_gym.envs.DEFAULT_WEIGHTS``.
+    ``aerostat_gym.envs.DEFAULT_WEIGHTS``, for the 300 m reference tether: on a tether k times
+    as long the displacement and length weights are divided by k^2 and the velocity weight by
+    k (``aerostat_gym.envs.reward.sized_weights``: a swing through the same angle scores the
+    same; ``reward_table(tether_length=L)`` lists the weights applied).
 
     The reward is swappable (:mod:`aerostat_gym.envs.reward`): ``reward_fn=f`` replaces it by
     ``f(obs, action, info)``, called after each step with the new observation, the applied
@@ -239,7 +242,10 @@ class TetheredAerostatEnv(gym.Env):
     - v0 (aerostat-gym 0.7.10; the registered tasks on the baseline's 300 m tether, the
       dynamics, observation and reward unchanged): a perturbation preset's swing and lateral
       displacement scale with the configured tether's length over 300 m (were 10 m and 5 m on
-      every tether: 10 deg of swing on a 60 m tether); a dict is still taken in metres.
+      every tether: 10 deg of swing on a 60 m tether); a dict is still taken in metres; the
+      default reward's displacement, length and velocity weights are divided by k^2, k^2 and k,
+      k = L / 300 m (were the baseline's on every tether, so a 60 m aerostat's swing weighed
+      25 times less against its pitch and effort terms than the baseline's).
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}

@@ -26,7 +26,9 @@ Measured across the five classical baselines (passive, tension, LQR, modal, LQG)
 steady-wind swing recoveries (along-wind, cross-wind and combined swings, 1 and 10 m, 3-15 m/s),
 the score's Spearman rank correlation with the fitted pendulum damping ratio averages 0.8
 (README, "One objective"). The weights are an environment argument (``reward_weights``,
-defaults :data:`DEFAULT_WEIGHTS`).
+defaults :data:`DEFAULT_WEIGHTS`), stated for the 300 m reference tether; on another tether
+the swing terms' weights follow its length (:func:`sized_weights`, since 0.7.10), so that a
+geometrically similar aerostat's swing through the same angle scores as the baseline's.
 
 Custom: pass ``reward_fn`` to the environment (``gym.make("TetheredAerostat-v0",
 reward_fn=f)``, or the vector env). ``f(obs, action, info) -> float`` is called once per step
@@ -48,7 +50,16 @@ from numba import njit
 from ..checks import is_finite_number
 from ..physics.core import FASTMATH
 from ..sim.events import FIELD_END, RUNNING
-from .spaces import OBS_DLENGTH, OBS_DPITCH, OBS_DX, OBS_DY, OBS_Q, OBS_VX, OBS_VY
+from .spaces import (
+    OBS_DLENGTH,
+    OBS_DPITCH,
+    OBS_DX,
+    OBS_DY,
+    OBS_Q,
+    OBS_VX,
+    OBS_VY,
+    displacement_scale,
+)
 
 #: A user reward: ``f(obs, action, info) -> float`` (see the module docstring).
 RewardFn = Callable[[np.ndarray, float, dict], float]
@@ -81,6 +92,14 @@ DEFAULT_WEIGHTS = {"displacement": 1.0, "velocity": 1.0, "pitch": 0.1, "pitch_ra
                    "length": 1.0}
 #: Free band of the length wander, as a fraction of the tether length (the ``length`` term).
 LENGTH_BAND_FRACTION = 0.05
+#: How the quantity of each swing term grows with the tether, as the power of k = L / 300 m
+#: (:func:`aerostat_gym.envs.spaces.displacement_scale`): a pendulum swung through the same
+#: angle on a geometrically similar aerostat (Froude similarity, period ~ sqrt(L)) has k times
+#: the displacement and length excursion and sqrt(k) times the velocity, so the squared terms
+#: grow as k^2, k and k^2. :func:`sized_weights` divides their weights by that, so every
+#: aerostat's swing weighs against its pitch, effort and tension terms (angles, fractions of
+#: the winch's speed and of its load: sized already) as the baseline's does.
+SIZE_POWERS = {"displacement": 2.0, "velocity": 1.0, "length": 2.0}
 
 
 def weights_vector(weights: dict | None) -> np.ndarray:
@@ -98,10 +117,20 @@ def weights_vector(weights: dict | None) -> np.ndarray:
     return np.array([w[k] for k in REWARD_TERMS])
 
 
-def reward_table(weights: dict | None = None) -> list[dict]:
+def sized_weights(weights: np.ndarray, tether_length: float | None) -> np.ndarray:
+    """The compiled reward's weights (REWARD_TERMS order) on a tether of ``tether_length`` [m]:
+    each term of :data:`SIZE_POWERS` divided by k ** power, k = L / 300 m (exactly the given
+    weights on the 300 m baseline, k = 1)."""
+    k = displacement_scale(tether_length)
+    return np.array([w / k ** SIZE_POWERS.get(name, 0.0)
+                     for name, w in zip(REWARD_TERMS, weights, strict=True)])
+
+
+def reward_table(weights: dict | None = None, tether_length: float | None = None) -> list[dict]:
     """Rows (term, weight, formula) of the default reward, in REWARD_TERMS order, with the
-    given weight overrides (like :func:`aerostat_gym.envs.observation_table`)."""
-    w = weights_vector(weights)
+    given weight overrides (like :func:`aerostat_gym.envs.observation_table`), as applied on a
+    tether of ``tether_length`` [m] (None: the 300 m reference; :func:`sized_weights`)."""
+    w = sized_weights(weights_vector(weights), tether_length)
     return [{"term": k, "weight": float(w[i]), "formula": REWARD_DOC[k]}
             for i, k in enumerate(REWARD_TERMS)]
 

@@ -16,6 +16,22 @@ import numpy as np
 
 from ..checks import is_finite_number
 
+#: The tether length [m] the task's sizes are stated for (the baseline's 300 m): the
+#: perturbation presets' displacements (:data:`aerostat_gym.envs.config.PERTURBATIONS`), the
+#: evaluator's recover swings, and the reward's swing terms (:func:`aerostat_gym.envs.reward.
+#: sized_weights`). On another tether they scale with its length, so that every aerostat is
+#: swung through the same angle about the winch (10 m on 300 m: 1.9 degrees, where 10 m on a
+#: 30 m tether would be 19 degrees, far outside the linear regime the task's controllers and
+#: the evaluator's fits assume) and scores it as the baseline does. The channels' scales below
+#: stay the baseline's on every aerostat.
+REFERENCE_TETHER_LENGTH = 300.0
+
+
+def displacement_scale(tether_length: float | None) -> float:
+    """Factor on stated displacements for a tether of ``tether_length`` [m] (None: the
+    reference, factor 1): ``tether_length`` / :data:`REFERENCE_TETHER_LENGTH`."""
+    return 1.0 if tether_length is None else float(tether_length) / REFERENCE_TETHER_LENGTH
+
 
 @dataclass(frozen=True)
 class Channel:
