@@ -157,7 +157,7 @@ class TetheredAerostatEnv(gym.Env):
       swing [m], lateral [m], pitch [rad], gust_probability, gust_amplitude [m/s] (low, high),
       gust_duration [s] (low, high), gust_onset [s] (low, high). A preset's swing and lateral
       displacement are stated for a 300 m tether and scale with the configured one (the same
-      swing angle on every aerostat; ``aerostat_gym.envs.config.displacement_scale``); a
+      swing angle on every aerostat; ``aerostat_gym.envs.spaces.displacement_scale``); a
       dict's are taken in metres.
     - ``tether_length=None`` [m] and ``n_elements=None``: override the parameter file.
     - ``integrator="semi-implicit"`` or ``"rk4"`` (the reference; about 7x slower).
