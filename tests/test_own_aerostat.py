@@ -57,7 +57,15 @@ from aerostat_gym.cli.stability import held_speeds
 from aerostat_gym.envs.batch import held_wind_top
 from aerostat_gym.envs.config import PERTURBATIONS, TaskConfig, TaskError
 from aerostat_gym.envs.episodes import TrimTable
-from aerostat_gym.envs.spaces import REFERENCE_TETHER_LENGTH, displacement_scale
+from aerostat_gym.envs.reward import DEFAULT_WEIGHTS, reward_table
+from aerostat_gym.envs.spaces import (
+    OBS_DX,
+    OBS_DY,
+    OBS_VX,
+    OBS_VY,
+    REFERENCE_TETHER_LENGTH,
+    displacement_scale,
+)
 from aerostat_gym.params import (
     SEMI_IMPLICIT_REFERENCE_DT,
     SEMI_IMPLICIT_REFERENCE_HULL_LENGTH,
@@ -477,9 +485,6 @@ def test_reward_swing_terms_are_sized_by_the_tether():
     on 0.05 x the volume on 60 m and 8 x on 1000 m (measured -0.865 and -0.792 against the
     baseline's -0.815, within 10 %; with the baseline's weights they would read -0.035 and
     -8.8)."""
-    from aerostat_gym.envs.reward import DEFAULT_WEIGHTS, reward_table
-    from aerostat_gym.envs.spaces import OBS_DX, OBS_DY, OBS_VX, OBS_VY
-
     assert {r["term"]: r["weight"] for r in reward_table(tether_length=300.0)} == DEFAULT_WEIGHTS
     sized = {r["term"]: r["weight"] for r in reward_table(tether_length=60.0)}
     assert sized == pytest.approx({**DEFAULT_WEIGHTS, "displacement": 25.0, "velocity": 5.0,
