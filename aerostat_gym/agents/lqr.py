@@ -60,6 +60,7 @@ from ..analysis.trim import Equilibrium, find_equilibrium
 from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
 from ..params import Params, dumps_toml
 from ..physics.state import StateLayout
+from .swing_plane import in_swing_plane
 
 #: Bryson "largest acceptable deviation" of each state group (SI units), the integral of the
 #: length error [m s], and the set-point (``None``: params.winch.max_speed). Q_ii = 1 / value^2.
@@ -646,11 +647,17 @@ class LQRPolicy:
     Notes
     -----
     Observation (``observation="full"``): index ``OBS_FULL_WIND`` holds U, the 6n+8 entries
-    from ``OBS_FULL_STATE`` hold x - x_trim. The set-point is v = -K(U) [dx; z], clipped to +-max_speed, and the action is
-    v / max_speed. The integral z (one per environment) travels in ``state``: z <- z + dt dL,
+    from ``OBS_FULL_STATE`` hold x - x_trim. The deviation is read in the swing plane
+    (:mod:`aerostat_gym.agents.swing_plane`, about the schedule's trim at U) when
+    :attr:`swing_plane` is set, so that a lateral swing's second-order dip in x and z does not
+    drive the longitudinal loop. The set-point is v = -K(U) [dx; z], clipped to +-max_speed,
+    and the action is v / max_speed. The integral z (one per environment) travels in ``state``: z <- z + dt dL,
     except while the command is saturated and integrating would push it further into
     saturation (conditional-integration anti-windup); ``episode_start`` resets it to 0.
     """
+
+    #: Read the longitudinal state in the swing plane (see the notes above).
+    swing_plane = True
 
     def __init__(self, params: Params, dt: float = 0.2, schedule: LQRSchedule | None = None,
                  privileged: bool = True, wind_range: tuple[float, float] | None = None):
@@ -696,6 +703,10 @@ class LQRPolicy:
         dx = obs2[:, OBS_FULL_STATE:OBS_FULL_STATE + self.layout.size].copy()
         ipsi = self.layout.euler.start + 2
         dx[:, ipsi] = (dx[:, ipsi] + np.pi) % (2.0 * np.pi) - np.pi
+        if self.swing_plane:
+            sch = self.schedule
+            x_ref = scheduled_tables(sch.speeds, {"x": sch.trims}, U)["x"]
+            dx = in_swing_plane(dx, x_ref, self.layout)
         K = self.schedule.gain(U)
         v = -np.einsum("ij,ij->i", K[:, :-1], dx) - K[:, -1] * z
         v_cmd = np.clip(v, -self.max_speed, self.max_speed)

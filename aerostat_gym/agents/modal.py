@@ -342,7 +342,14 @@ class ModalPolicy(LQRPolicy):
     ``predict`` is :meth:`LQRPolicy.predict`: v = -K(U) dx from the privileged full state and
     the episode's mean wind speed, clipped to +-max_speed. The integral gain is zero, so the
     integral state the LQR policy carries is inert here; the length loop is the placed pole.
+
+    It reads the raw deviation, not the swing plane (:attr:`LQRPolicy.swing_plane` off): it
+    moves only the pendulum pole pair, and where the LQR pumps a lateral swing (0.05 x the
+    baseline's volume on 60 m, 10 m/s, 5-20 m lateral starts) it lets the swing decay as fast
+    as the braked winch does. Its stored frontier and report rows are kept as they are.
     """
+
+    swing_plane = False
 
     def __init__(self, params: Params, dt: float = 0.2, schedule: ModalSchedule | None = None):
         super().__init__(params, dt=dt,
