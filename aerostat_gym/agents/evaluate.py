@@ -51,13 +51,13 @@ import numpy as np
 
 from ..envs.batch import held_wind_top
 from ..envs.config import DEFAULT_WIND_RANGE, check_control_step
-from ..envs.spaces import N_OBS, REFERENCE_TETHER_LENGTH, displacement_scale
+from ..envs.spaces import REFERENCE_TETHER_LENGTH, displacement_scale
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import Params, as_params, dumps_toml
 from .fit_guides import guide_kwargs, guides_for, screen_fits
 from .metrics import response_metrics
 from .policies import load_policy
-from .sb3io import PolicyError
+from .sb3io import policy_obs
 
 #: Sensor noise of the report suites (std in the observation's scaled units, on every standard
 #: channel): the level the LQG baseline is designed for and evaluated at in the README's
@@ -355,18 +355,6 @@ def rollout(policy, env, obs: np.ndarray, steps: int, record=None) -> tuple[np.n
         if record is not None:
             record(k, obs, alive)
     return returns, ended
-
-
-def policy_obs(policy, obs: np.ndarray) -> np.ndarray:
-    """The observation slice a policy reads: the standard channels or the privileged full set."""
-    need = getattr(policy, "obs_dim", None)
-    if need is None or need == obs.shape[1]:
-        return obs
-    if need == N_OBS:
-        return obs[:, :N_OBS]
-    raise PolicyError(f"the policy expects observations of {need} channels; the environment "
-                      f"gives {N_OBS} (observation='standard') or {obs.shape[1]} ('full'): it was "
-                      "trained for another observation layout")
 
 
 def episode_metrics(ep: Episodes, i: int) -> dict:

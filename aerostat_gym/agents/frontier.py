@@ -29,10 +29,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..envs.vector import TetheredAerostatVectorEnv
-from .evaluate import policy_obs
 from .metrics import fit_damped_sinusoid
 from .metrics_drift import fit_pendulum_with_drift
 from .modal import design_modal
+from .sb3io import policy_obs
 
 
 @dataclass

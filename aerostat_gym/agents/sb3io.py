@@ -46,6 +46,23 @@ def as_batch(obs) -> tuple[np.ndarray, bool]:
     return (obs[None, :], True) if obs.ndim == 1 else (obs, False)
 
 
+def policy_obs(policy, obs: np.ndarray) -> np.ndarray:
+    """The observation slice a policy reads (its ``obs_dim``): the standard channels, which
+    lead the privileged full set, or the full set itself. A batch of another width, or of a
+    layout the policy was not trained for, is refused with the shapes named."""
+    need = getattr(policy, "obs_dim", None)
+    if obs.ndim != 2:
+        raise PolicyError(f"observations must be one vector or a batch (N, channels), got shape "
+                          f"{obs.shape}")
+    if need is None or need == obs.shape[1]:
+        return obs
+    if need == N_OBS and obs.shape[1] > N_OBS:
+        return obs[:, :N_OBS]
+    raise PolicyError(f"the policy expects observations of {need} channels; the environment "
+                      f"gives {N_OBS} (observation='standard') or more ('full'), and this batch "
+                      f"has {obs.shape[1]}: it was trained for another observation layout")
+
+
 def to_actions(actions: np.ndarray, single: bool) -> np.ndarray:
     """Actions clipped to [-1, 1] as float32, shape (1,) or (N, 1)."""
     a = np.clip(actions, -1.0, 1.0).astype(np.float32).reshape(-1, 1)
@@ -156,6 +173,7 @@ class SB3Policy:
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         obs, single = as_batch(observation)
+        obs = policy_obs(self, obs)
         if self.plain:
             if self.norm is not None:
                 obs = self.norm.normalize_obs(obs)
