@@ -345,6 +345,7 @@ def _cross_checks(p: Params) -> None:
     if p.hull.l_h > p.aerostat.length:
         raise ParameterError(f"hull.l_h = {p.hull.l_h} m (nose to the fins' root) must not exceed "
                              f"aerostat.length = {p.aerostat.length} m")
+    check_inertia(p.aerostat)
     if not -89.0 < p.aerostat.trim_pitch_deg < 89.0:
         raise ParameterError(f"aerostat.trim_pitch_deg must lie in (-89, 89), got {p.aerostat.trim_pitch_deg}")
     d = Derived.from_params(p)
@@ -354,6 +355,17 @@ def _cross_checks(p: Params) -> None:
             f"<= weight {p.aerostat.mass * p.environment.g:.1f} N)"
         )
     _feasibility(p, d)
+
+
+def check_inertia(a) -> None:
+    """The body's inertia tensor must be positive definite, as every real mass distribution's is:
+    the x-z block [[Ixx, -Ixz], [-Ixz, Izz]] needs Ixz^2 < Ixx Izz (Ixx, Iyy, Izz > 0 are checked
+    field by field). An indefinite tensor gives a body that spins up from no applied moment."""
+    if a.Ixz ** 2 >= a.Ixx * a.Izz:
+        raise ParameterError(
+            f"aerostat.Ixz = {a.Ixz} kg m^2 makes the inertia tensor indefinite: a rigid body needs "
+            f"|Ixz| < sqrt(aerostat.Ixx * aerostat.Izz) = sqrt({a.Ixx} * {a.Izz}) = "
+            f"{math.sqrt(a.Ixx * a.Izz):.1f} kg m^2")
 
 
 def _feasibility(p: Params, d: Derived) -> None:

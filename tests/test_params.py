@@ -84,6 +84,10 @@ def test_round_trip_through_toml(base):
         ("tether.length", float("nan"), "tether.length must be finite"),
         ("wind.profile", "cubic", "wind.profile must be one of"),
         ("aerostat.mass", 1000.0, "gives no net lift"),
+        # |Ixz| at and above sqrt(Ixx Izz) = sqrt(3135 * 7103) = 4718.89 kg m^2
+        ("aerostat.Ixz", -30000.0, r"aerostat.Ixz = -30000.0 kg m\^2 makes the inertia tensor "
+                                   r"indefinite: .* = 4718.9 kg m\^2"),
+        ("aerostat.Ixz", 4718.9, "makes the inertia tensor indefinite"),
         ("aerostat.cb_position", [1.0, 2.0], "must be a list of 3 numbers"),
         ("tether.colour", "red", "unknown parameter 'tether.colour'"),
         ("nonsense", 1, "unknown parameter 'nonsense'"),
