@@ -604,11 +604,16 @@ def load_params(path: str | Path | None = None, overrides: dict[str, Any] | None
     return p
 
 
+def as_params(p: Params | str | Path | None, error: type[ValueError] = ParameterError) -> Params:
+    """Parameters given as a Params, a TOML path or a shipped configuration's name, or None
+    (the baseline); anything else is ``error`` naming its type. One door for the environment
+    and the controllers' designs."""
+    if p is None or isinstance(p, (str, os.PathLike)):
+        return load_params(p)
+    if not isinstance(p, Params):
+        raise error(f"params must be a Params, a TOML path or None, got {type(p).__name__}")
+    return p
 
-def as_params(params: Params | str | Path | None) -> Params:
-    """``params`` itself when it is a :class:`Params`, else :func:`load_params` of it (a TOML
-    path, a shipped configuration's name, or None for the baseline)."""
-    return params if isinstance(params, Params) else load_params(params)
 
 STATUSES = ("SOURCED", "DERIVED", "ESTIMATE", "CALIB", "USER")
 USER = "USER"

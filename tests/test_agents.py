@@ -17,6 +17,7 @@ from aerostat_gym.agents.train import train
 from aerostat_gym.analysis.reference import closed_form_periods
 from aerostat_gym.cli import main
 from aerostat_gym.envs.spaces import N_OBS
+from aerostat_gym.params import load_params
 from aerostat_gym.resources import shipped_path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -77,6 +78,21 @@ def test_policy_errors_are_clear(tmp_path, capsys):
         load_policy("telepathy")
     assert main(["evaluate", "--policy", str(bad), "--suite", "tiny"]) == 2
     assert "corrupt" in capsys.readouterr().err
+
+
+def test_policy_parameters_and_observations_are_checked_at_the_door():
+    """params: a Params, a TOML path or a shipped name (the same design either way), nothing
+    else; observations: real numbers, refused with what was given (was numpy's message)."""
+    with pytest.raises(PolicyError, match="params must be a Params, a TOML path or None, got int"):
+        load_policy("passive", params=5)
+    obs = np.linspace(-0.5, 0.5, N_OBS, dtype=np.float32)
+    by_name = load_policy("tension", params="tcom_32m").predict(obs)[0]
+    by_params = load_policy("tension", params=load_params("tcom_32m")).predict(obs)[0]
+    assert np.array_equal(by_name, by_params) and abs(float(by_name[0])) > 0
+    for name in ("passive", "tension", "lqr", "lqg", "shipped"):
+        with pytest.raises(ValueError, match="observations must be an array of real numbers, "
+                                             "got 'x'"):
+            load_policy(name).predict("x")
 
 
 def test_policy_for_another_observation_layout_is_rejected(tmp_path):

@@ -47,7 +47,7 @@ import scipy.linalg as sla
 
 from ..analysis.linear import state_steps
 from ..analysis.trim import find_equilibrium
-from ..envs.spaces import CHANNELS, N_OBS, check_obs_noise
+from ..envs.spaces import CHANNELS, N_OBS, as_batch, check_obs_noise
 from ..params import Params
 from ..physics.state import StateLayout
 from ..sim import Model
@@ -384,12 +384,10 @@ class LQGPolicy:
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """(actions, state): actions (1,) or (N, 1) float32 in [-1, 1]; state to pass back."""
-        obs = np.asarray(observation, dtype=float)
-        single = obs.ndim == 1
-        obs2 = obs[None, :] if single else obs
+        obs2, single = as_batch(observation, float)
         if obs2.ndim != 2 or obs2.shape[1] < N_OBS:
             raise ValueError(f"LQGPolicy needs the standard observation ({N_OBS} channels), got "
-                             f"shape {obs.shape}")
+                             f"shape {np.shape(observation)}")
         N = obs2.shape[0]
         S = self._state(state, N)
         start = np.isnan(S[:, 0])

@@ -57,7 +57,7 @@ from ..analysis.modes import (
     modes_from_eig,
 )
 from ..analysis.trim import Equilibrium, find_equilibrium
-from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
+from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND, as_batch
 from ..params import Params, dumps_toml
 from ..physics.state import StateLayout
 from .swing_plane import in_swing_plane
@@ -683,13 +683,11 @@ class LQRPolicy:
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """(actions, state): actions (1,) for one observation or (N, 1) for a batch, float32 in
         [-1, 1]; state is the (N,) array of integral states to pass back next step."""
-        obs = np.asarray(observation, dtype=float)
-        single = obs.ndim == 1
-        obs2 = obs[None, :] if single else obs
+        obs2, single = as_batch(observation, float)
         if obs2.ndim != 2 or obs2.shape[1] < self.obs_size:
             raise ValueError(
                 f"LQRPolicy needs the full-state observation of length {self.obs_size} "
-                f"(20 + 6n+8 with n = {self.layout.n_elements}), got shape {obs.shape}; make the "
+                f"(20 + 6n+8 with n = {self.layout.n_elements}), got shape {np.shape(observation)}; make the "
                 f"environment with observation='full'")
         N = obs2.shape[0]
         z = np.zeros(N) if state is None else np.array(state, dtype=float).reshape(-1).copy()

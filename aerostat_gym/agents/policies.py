@@ -31,14 +31,14 @@ import numpy as np
 
 from ..analysis.reference import reference_periods
 from ..envs.config import check_control_step
-from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION, check_obs_noise
-from ..params import Params, load_params
+from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION, as_batch, check_obs_noise
+from ..params import Params, as_params
 from ..resources import SHIPPED_POLICY, shipped_path
 from .lqg import LQGPolicy
 from .lqr import LQRPolicy
 from .modal import ModalPolicy
 from .residual import ShapedPolicy, check_residual, residual_shaper
-from .sb3io import PolicyError, as_batch, load_sb3, to_actions
+from .sb3io import PolicyError, load_sb3, to_actions
 
 BASELINES = ("passive", "tension", "lqr", "modal", "lqg", "modal_lqg", "modal_lqg_shaped",
              "modal_lqg_lowpass")
@@ -136,7 +136,7 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     and its residual base rebuilt for ``params`` and ``dt`` with the sensor noise it was
     trained with.
     """
-    params = params or load_params()
+    params = as_params(params, PolicyError)
     check_control_step(dt)  # the step the controllers are designed for
     if isinstance(name, os.PathLike):
         name = os.fspath(name)

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..envs.spaces import N_OBS
+from ..envs.spaces import N_OBS, as_batch
 
 VECNORM_SUFFIX = "_vecnormalize.pkl"
 WRAPPERS_SUFFIX = "_wrappers.json"
@@ -38,12 +38,6 @@ WRAPPER_KEYS = frozenset({"frame_stack", "residual"})
 
 class PolicyError(ValueError):
     """A policy that cannot be loaded or does not fit the environment (clear message)."""
-
-
-def as_batch(obs) -> tuple[np.ndarray, bool]:
-    """Observations as a float32 batch, and whether a single observation was given."""
-    obs = np.asarray(obs, dtype=np.float32)
-    return (obs[None, :], True) if obs.ndim == 1 else (obs, False)
 
 
 def policy_obs(policy, obs: np.ndarray) -> np.ndarray:

@@ -9,7 +9,6 @@ import difflib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
-from pathlib import Path
 
 import numpy as np
 
@@ -19,7 +18,7 @@ from ..params import (
     ParameterError,
     Params,
     apply_overrides,
-    load_params,
+    as_params,
     parameter_key,
     params_to_dict,
 )
@@ -153,11 +152,7 @@ class TaskConfig:
         r["randomize"] = self._randomize(r["params"])
 
     def _params(self) -> Params:
-        p = self.params
-        if p is None or isinstance(p, (str, Path)):
-            p = load_params(p)
-        elif not isinstance(p, Params):
-            raise TaskError(f"params must be a Params, a TOML path or None, got {type(p).__name__}")
+        p = as_params(self.params, TaskError)
         if self.overrides is not None and not isinstance(self.overrides, Mapping):
             raise TaskError("overrides must map dotted parameter names to values, e.g. "
                             f"{{'tether.length': 300.0}}; got {self.overrides!r}")

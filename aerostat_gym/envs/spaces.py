@@ -143,6 +143,21 @@ def scales() -> np.ndarray:
     return np.array([c.scale for c in CHANNELS])
 
 
+def as_batch(obs, dtype=np.float32) -> tuple[np.ndarray, bool]:
+    """Observations as a 2-D batch of ``dtype``, and whether a single vector was given: the one
+    door every policy's ``predict`` reads through. Anything that is not an array of real
+    numbers is a ValueError naming what was given (not numpy's conversion message)."""
+    try:
+        arr = np.asarray(obs)
+        ok = arr.dtype.kind in "biuf"
+    except (TypeError, ValueError):  # ragged nested lists
+        ok = False
+    if not ok:
+        raise ValueError(f"observations must be an array of real numbers, got {obs!r:.80}")
+    arr = arr.astype(dtype, copy=False)
+    return (arr[None, :], True) if arr.ndim == 1 else (arr, False)
+
+
 def check_obs_noise(value, error: type[ValueError] = ValueError) -> float:
     """A sensor-noise level (the standard deviation added to every standard channel, in scaled
     units) as a float: a finite real number >= 0, else ``error`` naming the value. One check
