@@ -76,6 +76,10 @@ def test_policy_errors_are_clear(tmp_path, capsys):
         load_policy(str(bad))
     with pytest.raises(PolicyError, match="unknown policy"):
         load_policy("telepathy")
+    with pytest.raises(PolicyError, match="is a directory, not a policy file"):
+        load_policy(str(tmp_path))
+    with pytest.raises(PolicyError, match="unknown policy ''"):
+        load_policy("")
     assert main(["evaluate", "--policy", str(bad), "--suite", "tiny"]) == 2
     assert "corrupt" in capsys.readouterr().err
 

@@ -169,7 +169,7 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
                               SHAPED_DEADBAND if name == "modal_lqg_shaped" else 0.0)
     if name in SHIPPED:
         return load_sb3(shipped_path(SHIPPED[name]), residual_factory)
-    if name.endswith(".zip") or Path(name).exists():
+    if name.endswith(".zip") or (name and Path(name).exists()):  # Path("") is the cwd
         return load_sb3(name, residual_factory)
     close = difflib.get_close_matches(name, BASELINES + tuple(SHIPPED), 1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""

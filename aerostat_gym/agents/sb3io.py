@@ -323,6 +323,8 @@ def load_sb3(path: str | Path, residual_factory=None) -> SB3Policy:
     into (base policy, :class:`CommandShaper`), validating it (required for a residual
     model)."""
     path = Path(path)
+    if path.is_dir():
+        raise PolicyError(f"{path} is a directory, not a policy file: give the model's .zip")
     if not path.is_file():
         raise PolicyError(f"policy file not found: {path}")
     if not zipfile.is_zipfile(path):
