@@ -120,8 +120,9 @@ def shaped_command(policy, dt: float = 0.2, deadband: float = SHAPED_DEADBAND) -
 
 def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
                 obs_noise: float = 0.0):
-    """A baseline by name designed for ``params`` (default: the baseline), a shipped trained
-    policy by name ('shipped': the package's default PPO policy) or a saved SB3 model (.zip).
+    """A baseline by name designed for ``params`` (a Params, a TOML path or a shipped
+    configuration's name; default: the baseline), a shipped trained policy by name
+    ('shipped': the package's default PPO policy) or a saved SB3 model (.zip).
 
     Baselines: 'passive' (braked winch), 'tension' (tension feedback), 'lqr' (gain-scheduled
     LQR over the wind range, privileged full state), 'modal' (pendulum pole placement,
