@@ -345,7 +345,7 @@ def _cross_checks(p: Params) -> None:
     if p.hull.l_h > p.aerostat.length:
         raise ParameterError(f"hull.l_h = {p.hull.l_h} m (nose to the fins' root) must not exceed "
                              f"aerostat.length = {p.aerostat.length} m")
-    check_inertia(p.aerostat)
+    check_inertia(p.aerostat.Ixx, p.aerostat.Iyy, p.aerostat.Izz, p.aerostat.Ixz)
     if not -89.0 < p.aerostat.trim_pitch_deg < 89.0:
         raise ParameterError(f"aerostat.trim_pitch_deg must lie in (-89, 89), got {p.aerostat.trim_pitch_deg}")
     d = Derived.from_params(p)
@@ -357,16 +357,40 @@ def _cross_checks(p: Params) -> None:
     _feasibility(p, d)
 
 
-def check_inertia(a: AerostatParams) -> None:
-    """The body's inertia tensor must be positive definite, as every real mass distribution's is:
+class InertiaError(ParameterError):
+    """Moments of inertia no mass distribution has (raised by :func:`check_inertia`). A joint
+    constraint: no single moment decides it, so range checks that move one parameter at a time
+    treat it apart (a domain randomisation redraws such a set)."""
+
+
+def check_inertia(ixx: float, iyy: float, izz: float, ixz: float) -> None:
+    """The body's inertia tensor must be one a mass distribution can have. (1) Positive definite:
     the x-z block [[Ixx, -Ixz], [-Ixz, Izz]] needs Ixz^2 < Ixx Izz (Ixx, Iyy, Izz > 0 are checked
-    field by field). With an indefinite tensor the kinetic energy (1/2) w.I.w is negative for
-    some rotations and the motion diverges (Ixz = -30000 kg m^2 on the baseline did, at 5.6 s)."""
-    if a.Ixz ** 2 >= a.Ixx * a.Izz:
-        raise ParameterError(
-            f"aerostat.Ixz = {a.Ixz} kg m^2 makes the inertia tensor indefinite: a rigid body needs "
-            f"|Ixz| < sqrt(aerostat.Ixx * aerostat.Izz) = sqrt({a.Ixx} * {a.Izz}) = "
-            f"{math.sqrt(a.Ixx * a.Izz):.1f} kg m^2")
+    field by field); with an indefinite tensor the kinetic energy (1/2) w.I.w is negative for
+    some rotations and the motion diverges (Ixz = -30000 kg m^2 on the baseline did, at 5.6 s).
+    (2) The triangle inequalities: each principal moment is at most the sum of the other two,
+    since e.g. I1 + I2 - I3 = 2 * integral of (the third axis coordinate)^2 dm >= 0. The
+    principal moments are Iyy and the x-z block's eigenvalues l+, l- (sum Ixx + Izz, difference
+    sqrt((Ixx - Izz)^2 + 4 Ixz^2)), so the inequalities read Iyy <= Ixx + Izz and
+    l+ - l- <= Iyy. Equality (a flat body) is allowed. Raises :class:`InertiaError`."""
+    if ixz ** 2 >= ixx * izz:
+        raise InertiaError(
+            f"aerostat.Ixz = {ixz} kg m^2 makes the inertia tensor indefinite: a rigid body needs "
+            f"|Ixz| < sqrt(aerostat.Ixx * aerostat.Izz) = sqrt({ixx} * {izz}) = "
+            f"{math.sqrt(ixx * izz):.1f} kg m^2")
+    tol = 1e-12 * (ixx + iyy + izz)  # rounding of an exactly flat body
+    if iyy > ixx + izz + tol:
+        raise InertiaError(
+            f"aerostat.Iyy = {iyy} kg m^2 exceeds aerostat.Ixx + aerostat.Izz = {ixx} + "
+            f"{izz} = {ixx + izz:.1f} kg m^2: no mass distribution has such moments "
+            "(Ixx + Izz - Iyy = 2 * integral of y^2 dm must be >= 0)")
+    spread = math.hypot(ixx - izz, 2.0 * ixz)
+    if spread > iyy + tol:
+        raise InertiaError(
+            f"aerostat.Ixx = {ixx}, aerostat.Izz = {izz} and aerostat.Ixz = {ixz} kg m^2 "
+            f"give x-z principal moments {spread:.1f} kg m^2 apart, more than aerostat.Iyy = "
+            f"{iyy} kg m^2: no mass distribution has such moments (each principal moment is "
+            "at most the sum of the other two)")
 
 
 def _feasibility(p: Params, d: Derived) -> None:

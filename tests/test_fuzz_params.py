@@ -143,7 +143,8 @@ MUTATIONS = [
     ("aerostat.Ixz", 0.0, None),
     ("tether.Cd_normal", 0.0, None),
     ("hull.eta_k", 0.0, None),
-    ("aerostat.Izz", 1e6, None),
+    ("aerostat.Izz", 1e6, "aerostat.Iyy"),  # |Izz - Ixx| > Iyy: no body has it
+    ("aerostat.Izz", 10000.0, None),
     ("winch.max_motor_force", 1e5, None),
 ]
 

@@ -88,6 +88,12 @@ def test_round_trip_through_toml(base):
         ("aerostat.Ixz", -30000.0, r"aerostat.Ixz = -30000.0 kg m\^2 makes the inertia tensor "
                                    r"indefinite: .* = 4718.9 kg m\^2"),
         ("aerostat.Ixz", 4718.9, "makes the inertia tensor indefinite"),
+        # triangle inequalities: Iyy <= Ixx + Izz = 10238 and |Izz - Ixx| (Ixz small) <= Iyy
+        ("aerostat.Iyy", 10300.0, r"aerostat.Iyy = 10300.0 kg m\^2 exceeds aerostat.Ixx \+ "
+                                  r"aerostat.Izz = 3135.0 \+ 7103.0 = 10238.0 kg m\^2"),
+        ("aerostat.Izz", 11000.0, r"aerostat.Ixx = 3135.0, aerostat.Izz = 11000.0 and aerostat.Ixz "
+                                  r"= -300.0 kg m\^2 give x-z principal moments 7887.9 kg m\^2 "
+                                  r"apart, more than aerostat.Iyy = 7487.0"),
         ("aerostat.cb_position", [1.0, 2.0], "must be a list of 3 numbers"),
         ("tether.colour", "red", "unknown parameter 'tether.colour'"),
         ("nonsense", 1, "unknown parameter 'nonsense'"),
@@ -97,6 +103,36 @@ def test_round_trip_through_toml(base):
 def test_invalid_values_name_the_field(base, key, value, message):
     with pytest.raises(ParameterError, match=message):
         base.replace(**{key: value})
+
+
+def test_inertia_check_is_the_principal_moment_triangle(base):
+    """The loader accepts an inertia tensor exactly when its principal moments (numpy's
+    eigenvalues of [[Ixx, 0, -Ixz], [0, Iyy, 0], [-Ixz, 0, Izz]]) are positive and each is at
+    most the sum of the other two, on 400 random tensors (about half of them refused) kept
+    1e-6 away from the boundary; and a flat body (Izz = Ixx + Iyy, a plate) is accepted."""
+    import numpy as np
+
+    rng = np.random.default_rng(20261206)
+    verdicts = []
+    for _ in range(400):
+        ixx, iyy, izz = rng.uniform(1000.0, 12000.0, 3)
+        ixz = rng.uniform(-3000.0, 3000.0)
+        lam = np.linalg.eigvalsh([[ixx, 0.0, -ixz], [0.0, iyy, 0.0], [-ixz, 0.0, izz]])
+        margin = min(lam[0], lam[0] + lam[1] - lam[2]) / lam.sum()
+        if abs(margin) < 1e-6:
+            continue
+        over = {"aerostat.Ixx": ixx, "aerostat.Iyy": iyy, "aerostat.Izz": izz, "aerostat.Ixz": ixz}
+        try:
+            base.replace(**over)
+            accepted = True
+        except ParameterError:
+            accepted = False
+        assert accepted == (margin > 0), over
+        verdicts.append(accepted)
+    assert 0.3 < np.mean(verdicts) < 0.7
+    plate = base.replace(**{"aerostat.Ixz": 0.0, "aerostat.Izz": base.aerostat.Ixx
+                            + base.aerostat.Iyy})
+    assert plate.aerostat.Izz == pytest.approx(10622.0)
 
 
 def test_unknown_key_missing_key_missing_section(base):

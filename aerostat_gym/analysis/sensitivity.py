@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ..params import Params, load_params, params_to_dict
+from ..params import ParameterError, Params, load_params, params_to_dict
 from .modes import FIGURE9_MODES, SETS, analyse
 from .reference import TABLE2, linear_table2_periods
 from .trim import TrimError, find_equilibrium
@@ -39,6 +39,10 @@ class Knob:
     label : text for tables. status : ESTIMATE or CALIB. unit : unit of the knob's value.
     low, high : ends of the plausible range. source : where the range comes from.
     get : value of the knob in a parameter set. put : parameter set with the knob at a value.
+    override : the dotted parameter name when ``put`` sets that one field and nothing else
+        (None for a derived knob), so that several draws can be applied as one override and
+        checked together (e.g. the inertia triangle inequalities, which no single moment
+        decides).
     """
 
     key: str
@@ -50,12 +54,13 @@ class Knob:
     source: str
     get: Callable[[Params], float]
     put: Callable[[Params, float], Params]
+    override: str | None = None
 
 
-def _dotted(key: str) -> tuple[Callable, Callable]:
+def _dotted(key: str) -> tuple[Callable, Callable, str]:
     sec, name = key.split(".")
     return (lambda p: float(getattr(getattr(p, sec), name)),
-            lambda p, v: p.replace(**{key: float(v)}))
+            lambda p, v: p.replace(**{key: float(v)}), key)
 
 
 def _vector_component(key: str, k: int) -> tuple[Callable, Callable]:
@@ -237,7 +242,7 @@ def sensitivity_table(params: Params | None = None, knobs: list[Knob] | None = N
         row = {"knob": k.key, "label": k.label, "status": k.status, "unit": k.unit,
                "baseline": k.get(p), "low": k.low, "high": k.high, "source": k.source}
         for end in ("low", "high"):
-            res = stability_figures(k.put(p, getattr(k, end)), speeds)
+            res = _end_figures(k, p, getattr(k, end), speeds)
             row[end + "_result"] = res
             if "error" not in res:
                 row[end + "_pct"] = {key: 100 * (res[key] - base[key]) / base[key] for key in PERIOD_KEYS}
@@ -280,16 +285,31 @@ def _signed(x: float) -> str:
     return "   n/a" if math.isnan(x) else f"{x:+6.1f}"
 
 
+def _end_figures(knob: Knob, params: Params, value: float, speeds) -> dict:
+    """:func:`stability_figures` with one knob moved to ``value``. An end the loader refuses is
+    recorded ({"error": ..., "invalid": True}), not raised: on an aerostat whose moments sit
+    near a triangle inequality, one moment of inertia moved alone can leave every body."""
+    try:
+        moved = knob.put(params, value)
+    except ParameterError as exc:
+        return {"error": str(exc), "invalid": True}
+    return stability_figures(moved, speeds)
+
+
 def _plain(x: float) -> str:
     return "   n/a" if math.isnan(x) else f"{x:6.3f}"
 
 
 def _verdict(ends) -> str:
     """' UNSTABLE' where an end's sweep found an unstable mode, ' NO TRIM (low/high)' where an
-    end has no trim to judge; nothing when both ends are stable everywhere."""
-    failed = [name for name, e in zip(("low", "high"), ends, strict=True) if "error" in e]
-    if failed:
-        return f" NO TRIM ({'/'.join(failed)})"
+    end has no trim to judge, ' INVALID (low/high)' where the loader refuses an end; nothing
+    when both ends are stable everywhere."""
+    named = tuple(zip(("low", "high"), ends, strict=True))
+    invalid = [name for name, e in named if e.get("invalid")]
+    failed = [name for name, e in named if "error" in e and not e.get("invalid")]
+    if invalid or failed:
+        return "".join(f" {what} ({'/'.join(names)})" for what, names in
+                       (("INVALID", invalid), ("NO TRIM", failed)) if names)
     return "" if all(e.get("all_stable", False) for e in ends) else " UNSTABLE"
 
 
@@ -311,7 +331,7 @@ def solve_for_period(params: Params, knob: Knob, target: float, key: str = "lat_
         try:
             p = knob.put(params, v)
             return linear_table2_periods(analyse(p, find_equilibrium(p, wind_speed)))[key] - target
-        except TrimError:
+        except (ParameterError, TrimError):  # no aerostat at v, or no trim: no period
             return math.nan
 
     xs = np.linspace(lo, hi, grid)

@@ -130,6 +130,9 @@ def format_summary(s: dict) -> str:
         f" (95 % CI {100 * lo:.1f}-{100 * hi:.1f} %); complete sweeps {s['complete']}, "
         f"failed {s['n_errors']}",
     ]
+    if s["rejected_draws"]:
+        lines.append(f"redrawn: {s['rejected_draws']} draws that are no valid aerostat (first: "
+                     f"{s['rejections'][0]})")
     lines += _probability_lines(s)
     lines.append("Table 2 periods at 1 m/s [s]: median [5 %, 95 %] (sets where the mode "
                  "oscillates)")

@@ -15,10 +15,12 @@ import numpy as np
 from ..checks import is_finite_number, is_number, is_whole
 from ..params import (
     SECTIONS,
+    InertiaError,
     ParameterError,
     Params,
     apply_overrides,
     as_params,
+    check_inertia,
     parameter_key,
     params_to_dict,
 )
@@ -174,6 +176,7 @@ class TaskConfig:
                 raise TaskError(f"randomize[{key!r}] must be a relative half-range in [0, 1), "
                                 f"got {rel!r}")
             _check_range_ends(params, key, rel)
+        _check_inertia_draws(params, spec)
         return dict(spec)
 
     @property
@@ -216,16 +219,58 @@ def turbulence_mix(spec, turb, given) -> tuple[tuple[str, ...], np.ndarray] | No
 
 def _check_range_ends(params: Params, key: str, rel: float) -> None:
     """Both ends of a randomisation range must load: a range whose end is infeasible (no net
-    lift, a tether length outside the winch's limits, ...) is refused when the env is made."""
+    lift, a tether length outside the winch's limits, ...) is refused when the env is made.
+    The inertia constraints are joint (an Iyy that is too large with the nominal Izz is a body
+    with a larger Izz): :func:`_check_inertia_draws` checks them over the drawn combinations."""
     value = get_parameter(params, key)
     if not is_number(value):
         raise TaskError(f"randomize[{key!r}] must name a scalar number parameter, got {value!r}")
     for end in (1.0 - rel, 1.0 + rel):
         try:
             apply_overrides(params, {key: value * end})
+        except InertiaError:
+            pass
         except ParameterError as exc:
             raise TaskError(f"randomize[{key!r}] = {rel!r} reaches {key} = {value * end:.6g}, "
                             f"which the loader refuses: {exc}") from None
+
+
+#: the inertia components a randomisation may draw, in :func:`check_inertia`'s order
+INERTIA_KEYS = ("aerostat.Ixx", "aerostat.Iyy", "aerostat.Izz", "aerostat.Ixz")
+#: a randomisation whose inertia draws are bodies less often than this is refused when made
+MIN_INERTIA_ACCEPTANCE = 0.05
+#: draws of the fixed-seed estimate of that share
+INERTIA_ACCEPTANCE_DRAWS = 2000
+
+
+def inertia_acceptance(params: Params, spec: Mapping[str, float]) -> tuple[float, str]:
+    """Share of the randomisation's independent inertia draws that a body can have (the
+    triangle inequalities and a definite tensor, :func:`check_inertia`), estimated from
+    :data:`INERTIA_ACCEPTANCE_DRAWS` draws of a fixed generator, with the first refusal's
+    message ("" if none). An episode start redraws the others."""
+    nominal = np.array([get_parameter(params, k) for k in INERTIA_KEYS])
+    rel = np.array([spec.get(k, 0.0) for k in INERTIA_KEYS])
+    u = np.random.default_rng(0).uniform(-1.0, 1.0, (INERTIA_ACCEPTANCE_DRAWS, len(INERTIA_KEYS)))
+    ok, first = 0, ""
+    for row in nominal * (1.0 + rel * u):
+        try:
+            check_inertia(*row)
+            ok += 1
+        except InertiaError as exc:
+            first = first or str(exc)
+    return ok / INERTIA_ACCEPTANCE_DRAWS, first
+
+
+def _check_inertia_draws(params: Params, spec: Mapping[str, float]) -> None:
+    drawn = [k for k in INERTIA_KEYS if spec.get(k)]
+    if not drawn:
+        return
+    share, first = inertia_acceptance(params, spec)
+    if share < MIN_INERTIA_ACCEPTANCE:
+        raise TaskError(
+            f"randomize draws {', '.join(drawn)} independently and only {100 * share:.1f} % of "
+            f"those draws are moments of inertia a body can have (e.g. {first}); narrow their "
+            f"ranges (at least {100 * MIN_INERTIA_ACCEPTANCE:.0f} % must be)")
 
 
 def get_parameter(params: Params, key: str):

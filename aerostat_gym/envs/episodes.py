@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis.trim import Equilibrium, TrimError, find_equilibrium, largest_trim_tension
-from ..params import ParameterError, Params, apply_overrides, dumps_toml
+from ..params import InertiaError, ParameterError, Params, apply_overrides, dumps_toml
 from ..physics.core import euler_angles, rotation_matrix
 from ..physics.packing import pack_params
 from ..physics.state import StateLayout
@@ -41,6 +41,10 @@ FIELD_PERIOD_HORIZON = 120.0
 MAX_CACHED_BANKS = 4
 #: draws of the randomised parameters per episode start before the start is an error
 MAX_REDRAWS = 20
+#: further draws allowed for moments of inertia no body has (cheap: refused before any trim;
+#: a randomisation is made only where at least 5 % of the inertia draws are bodies, so 1000
+#: redraws all fail with probability below 0.95^1000 ~ 5e-23)
+MAX_INERTIA_REDRAWS = 1000
 
 
 # --- trims, shared between environments with the same parameters -------------------------------
@@ -204,13 +208,20 @@ def _speed_index(trims: TrimTable, fixed, rng) -> int:
 
 
 def _parameters(task: TaskConfig, trims: TrimTable, k: int, rng) -> tuple[Params, np.ndarray]:
-    """Nominal parameters and trim, or randomised ones re-trimmed from the nominal trim."""
+    """Nominal parameters and trim, or randomised ones re-trimmed from the nominal trim.
+
+    The randomised parameters are drawn independently and uniformly in their ranges; a draw
+    whose moments of inertia no body has (a triangle inequality broken, about 10 % of the
+    default draws) is drawn again, so the episode's aerostat is uniform over the ranges'
+    physical part. A draw that loads but does not trim is drawn again too, a bounded number of
+    times (:data:`MAX_REDRAWS`)."""
     spec = task.resolved["randomize"]
     if not spec:
         return trims.params, trims.states[k].copy()
     base = trims.params
     last = None
-    for _ in range(MAX_REDRAWS):  # combinations of feasible range ends may still be infeasible
+    failures = no_body = 0
+    while failures < MAX_REDRAWS and no_body < MAX_INERTIA_REDRAWS:
         over = {key: get_parameter(base, key) * (1.0 + rng.uniform(-rel, rel))
                 for key, rel in spec.items()}
         try:
@@ -218,10 +229,12 @@ def _parameters(task: TaskConfig, trims: TrimTable, k: int, rng) -> tuple[Params
             eq = find_equilibrium(params, float(trims.speeds[k]), guess=trims.equilibrium(k),
                                   max_step=WIND_GRID)
             return params, eq.x
+        except InertiaError as exc:
+            no_body, last = no_body + 1, exc
         except (ParameterError, TrimError) as exc:
-            last = exc
-    raise TaskError(f"randomize {spec} gave no feasible aerostat in {MAX_REDRAWS} draws at "
-                    f"U = {trims.speeds[k]} m/s (last: {last}); narrow the ranges")
+            failures, last = failures + 1, exc
+    raise TaskError(f"randomize {spec} gave no feasible aerostat in {failures + no_body} draws "
+                    f"at U = {trims.speeds[k]} m/s (last: {last}); narrow the ranges")
 
 
 def _field(cfg, bank_shape, ua, wp, rng) -> tuple[int, float]:

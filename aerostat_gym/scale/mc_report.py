@@ -144,6 +144,8 @@ def summarize(study: Study, nominal=None) -> dict:
                        for k, r, v in zip(study.keys, study.ranges, study.nominal, strict=True)],
         "complete": int(ok.sum()), "errors": [s.error for s in study.samples if s.error][:10],
         "n_errors": int((~ok).sum()),
+        "rejected_draws": int(study.meta.get("rejected", 0)),
+        "rejections": list(study.meta.get("rejections", [])),
         "stable_everywhere": {"count": int(every.sum()), "fraction": float(every.mean()),
                               "ci95": [lo, hi],
                               "fraction_of_complete": float(every[ok].mean()) if ok.any()

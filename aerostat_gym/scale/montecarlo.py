@@ -3,7 +3,9 @@ share one per-sample function, so they give identical numbers for the same seed.
 
 A study draws N parameter sets uniformly from the ranges of :mod:`aerostat_gym.scale.ranges`
 (all values drawn up front from ``numpy.random.default_rng(seed)``, so a sample's values do not
-depend on how the samples are batched or scheduled). Each set is trimmed by continuation in
+depend on how the samples are batched or scheduled). A draw the loader refuses, such as moments
+of inertia that break a triangle inequality, is not an aerostat and is redrawn
+(:func:`draw_valid`); the study's metadata counts them. Each set is trimmed by continuation in
 wind speed and linearized at every speed of the sweep; per speed the study records, for each
 Figure 9 mode, whether it is stable, its damping ratio and period, whether every mode of the
 linear model (tether harmonics included) is stable, and the largest real part of a non-neutral
@@ -23,7 +25,7 @@ from ..analysis.modes import FIGURE9_MODES, SETS, ModalAnalysis, analyse
 from ..analysis.reference import TABLE2, TABLE2_MODES
 from ..analysis.trim import TrimError, find_equilibrium
 from ..checks import is_whole
-from ..params import ParameterError, Params
+from ..params import ParameterError, Params, apply_overrides
 from .cluster import start_ray, stop_ray
 from .ranges import ParameterRange
 
@@ -97,6 +99,22 @@ class Study:
         return np.stack([getattr(s, name) for s in self.samples])
 
 
+#: A study gives up when this many draws per requested set left it short of valid sets.
+MAX_DRAWS_PER_SET = 100
+
+
+def _uniform(rng: np.random.Generator, ranges: list[ParameterRange], rows: int) -> np.ndarray:
+    u = rng.uniform(size=(rows, len(ranges)))
+    low = np.array([r.low for r in ranges])
+    high = np.array([r.high for r in ranges])
+    return low + u * (high - low)
+
+
+def _check_samples(n) -> None:
+    if not is_whole(n):
+        raise ValueError(f"--samples must be an integer >= 1, got {n!r}")
+
+
 def draw_values(ranges: list[ParameterRange], n: int, seed: int) -> np.ndarray:
     """(n, len(ranges)) values, each uniform in its range, from ``default_rng(seed)``.
 
@@ -106,12 +124,48 @@ def draw_values(ranges: list[ParameterRange], n: int, seed: int) -> np.ndarray:
     n : number of parameter sets.
     seed : seed of the generator.
     """
-    if not is_whole(n):
-        raise ValueError(f"--samples must be an integer >= 1, got {n!r}")
-    u = np.random.default_rng(seed).uniform(size=(n, len(ranges)))
-    low = np.array([r.low for r in ranges])
-    high = np.array([r.high for r in ranges])
-    return low + u * (high - low)
+    _check_samples(n)
+    return _uniform(np.random.default_rng(seed), ranges, n)
+
+
+def draw_valid(base: Params, ranges: list[ParameterRange], n: int,
+               seed: int) -> tuple[np.ndarray, list[str]]:
+    """n parameter sets uniform in their ranges and conditioned on being valid parameter sets.
+
+    A draw the loader refuses (:class:`ParameterError`: e.g. three independently drawn moments
+    of inertia that break a triangle inequality, no mass distribution has them, or a set with
+    no net lift) is not an aerostat, so it is redrawn rather than counted: the study is over n
+    aerostats that can exist. The first n draws are :func:`draw_values`'s, so a study whose
+    draws are all valid is unchanged; the further draws come from the same generator.
+
+    Returns
+    -------
+    values : (n, len(ranges)) drawn values, in range order.
+    rejected : the loader's message for every draw redrawn, in draw order.
+    """
+    _check_samples(n)
+    rng = np.random.default_rng(seed)
+    kept: list[np.ndarray] = []
+    rejected: list[str] = []
+    drawn = 0
+    while len(kept) < n:
+        if drawn >= MAX_DRAWS_PER_SET * n:
+            raise ValueError(
+                f"only {len(kept)} of {drawn} parameter sets drawn from the ranges are valid "
+                f"(first refusal: {rejected[0]}); narrow the ranges")
+        rows = _uniform(rng, ranges, n - len(kept))
+        drawn += len(rows)
+        for row in rows:
+            try:
+                sample_params(base, ranges, row)
+                kept.append(row)
+            except ParameterError as exc:
+                rejected.append(str(exc))
+    return np.array(kept), rejected
+
+
+def _rejection_meta(rejected: list[str]) -> dict:
+    return {"rejected": len(rejected), "rejections": rejected[:5]}
 
 
 def check_speeds(speeds) -> np.ndarray:
@@ -131,11 +185,20 @@ def sample_params(base: Params, ranges: list[ParameterRange], values: np.ndarray
     With the documented ranges the CM shift (which moves the nose and fin points, and the CB,
     aft by the shift) is applied before the CB position, which then sets the CB relative to the
     CM outright: the two draws are independent uncertainties of the fin arm and of the CB.
+    Consecutive plain-field draws (``override`` set) are applied as one override, so that the
+    checks between fields see the drawn set, not a half-drawn one (three drawn moments of
+    inertia can satisfy the triangle inequalities where the first two with the nominal third
+    do not, and the other way round).
     """
-    p = base
+    p, pending = base, {}
     for r, v in zip(ranges, values, strict=True):
+        if r.override is not None:
+            pending[r.override] = float(v)
+            continue
+        if pending:
+            p, pending = apply_overrides(p, pending), {}
         p = r.put(p, float(v))
-    return p
+    return apply_overrides(p, pending) if pending else p
 
 
 def _empty(values: np.ndarray, n_speeds: int, error: str = "") -> SampleResult:
@@ -229,14 +292,15 @@ def run_serial(base: Params, ranges: list[ParameterRange], n: int, seed: int,
     progress : called with (done, n) after every sample.
     """
     speeds = check_speeds(speeds)
-    values = draw_values(ranges, n, seed)
+    values, rejected = draw_valid(base, ranges, n, seed)
     t0 = time.perf_counter()
     out = []
     for i, row in enumerate(values):
         out.append(evaluate_sample(base, ranges, row, speeds))
         if progress:
             progress(i + 1, n)
-    return _study(base, ranges, speeds, seed, out, "serial", time.perf_counter() - t0, {})
+    return _study(base, ranges, speeds, seed, out, "serial", time.perf_counter() - t0,
+                  _rejection_meta(rejected))
 
 
 def batch_bounds(n: int, batch_size: int) -> list[tuple[int, int]]:
@@ -270,7 +334,7 @@ def run_ray(base: Params, ranges: list[ParameterRange], n: int, seed: int,
     progress : called with (done, n) as batches finish.
     """
     speeds = check_speeds(speeds)
-    values = draw_values(ranges, n, seed)
+    values, rejected = draw_valid(base, ranges, n, seed)
     start = start_ray("running the study on Ray", address, workers,
                       hint="; or run it without Ray with --serial")
     ray = start.ray
@@ -286,7 +350,8 @@ def run_ray(base: Params, ranges: list[ParameterRange], n: int, seed: int,
     finally:
         stop_ray(start)
     meta = {"ray_import_s": start.import_s, "ray_init_s": start.init_s, "cpus": start.cpus,
-            "batch_size": size, "batches": len(bounds), "address": address or "local"}
+            "batch_size": size, "batches": len(bounds), "address": address or "local",
+            **_rejection_meta(rejected)}
     samples = [s for batch in results for s in batch]
     return _study(base, ranges, speeds, seed, samples, "ray", seconds, meta)
 

@@ -37,6 +37,8 @@ class ParameterRange:
     high : upper end of the range.
     nominal : value in the base parameter set.
     put : returns a parameter set with this parameter at a value.
+    override : the dotted parameter name when ``put`` sets only that field (None for a derived
+        knob): :func:`~aerostat_gym.scale.montecarlo.sample_params` applies such draws together.
     """
 
     key: str
@@ -44,10 +46,11 @@ class ParameterRange:
     high: float
     nominal: float
     put: Callable[[Params, float], Params]
+    override: str | None = None
 
 
 def _documented(params: Params) -> list[ParameterRange]:
-    return [ParameterRange(k.key, k.low, k.high, k.get(params), k.put)
+    return [ParameterRange(k.key, k.low, k.high, k.get(params), k.put, k.override)
             for k in default_knobs(params)]
 
 
@@ -61,7 +64,7 @@ def _randomization(params: Params) -> list[ParameterRange]:
         sec, _, name = key.partition(".")
         nominal = float(getattr(getattr(params, sec), name))
         lo, hi = sorted((nominal * (1.0 - rel), nominal * (1.0 + rel)))
-        out.append(ParameterRange(key, lo, hi, nominal, _override(key)))
+        out.append(ParameterRange(key, lo, hi, nominal, _override(key), key))
     return out
 
 
