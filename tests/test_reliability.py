@@ -604,6 +604,52 @@ def test_10_wide_randomisation_resets_never_raise():
         assert 0.1 - 1e-12 <= ratio <= 1.9 + 1e-12
 
 
+def _principal_moments(a) -> np.ndarray:
+    return np.linalg.eigvalsh([[a.Ixx, 0.0, -a.Ixz], [0.0, a.Iyy, 0.0], [-a.Ixz, 0.0, a.Izz]])
+
+
+def test_10_randomised_aerostats_are_bodies_that_can_exist(monkeypatch):
+    """randomize=True draws Ixx, Iyy, Izz independently by +-30 %: about 11 % of such draws
+    break a triangle inequality (Iyy > Ixx + Izz mostly). Every episode's aerostat has positive
+    principal moments (numpy's eigenvalues), each at most the sum of the other two, and some
+    of the 40 starts needed a redraw (counted through the loader's refusals)."""
+    env = TetheredAerostatEnv(randomize=True, n_elements=5, wind_speed=(5.0, 12.0), **QUIET)
+    refused = []
+    real = episodes.apply_overrides
+
+    def spy(*args, **kwargs):
+        try:
+            return real(*args, **kwargs)
+        except ParameterError as exc:
+            refused.append(str(exc))
+            raise
+
+    monkeypatch.setattr(episodes, "apply_overrides", spy)
+    for seed in range(40):
+        env.reset(seed=seed)
+        lam = _principal_moments(env.episode.params.aerostat)
+        assert lam[0] > 0 and lam[2] <= lam[0] + lam[1] * (1 + 1e-12), (seed, lam)
+    assert refused and all("no mass distribution has such moments" in m for m in refused)
+
+
+def test_10_inertia_ranges_that_leave_few_bodies_are_refused_when_made():
+    """A needle-like aerostat (Ixx 200, Iyy 7100, Izz 7000 kg m^2, Ixz 0: a body, since
+    7100 <= 7200 and 6800 <= 7100) with +-90 % on each moment: about 2.5 % of the draws are
+    bodies, under the 5 % floor, so the env is refused when made, naming the keys. Its Iyy
+    alone at +90 % is no body either, yet is not refused by the range-end check: Izz may be
+    drawn larger with it. At +-90 % on the baseline 38 % are bodies and the env is made."""
+    needle = load_params().replace(**{"aerostat.Ixx": 200.0, "aerostat.Iyy": 7100.0,
+                                      "aerostat.Izz": 7000.0, "aerostat.Ixz": 0.0})
+    wide = {"aerostat.Ixx": 0.9, "aerostat.Iyy": 0.9, "aerostat.Izz": 0.9}
+    with pytest.raises(TaskError, match=r"randomize draws aerostat.Ixx, aerostat.Iyy, "
+                                        r"aerostat.Izz independently and only 2\.\d % of those "
+                                        r"draws are moments of inertia a body can have"):
+        TetheredAerostatEnv(params=needle, randomize=wide, n_elements=5, **QUIET)
+    with pytest.raises(ParameterError, match="no mass distribution"):
+        needle.replace(**{"aerostat.Iyy": 7100.0 * 1.9})
+    TetheredAerostatEnv(randomize=wide, n_elements=5, **QUIET)
+
+
 # --- 11. action coercion ----------------------------------------------------------------------------
 
 
