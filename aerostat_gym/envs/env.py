@@ -170,8 +170,11 @@ class TetheredAerostatEnv(gym.Env):
     - ``params=None``: a :class:`aerostat_gym.params.Params` or a TOML path (default: the
       shipped baseline); ``overrides``: {"section.key": value}.
     - ``randomize=None``: domain randomisation, {"section.key": relative half-range} or True for
-      the estimated parameters in ``aerostat_gym.envs.task.DEFAULT_RANDOMIZATION``; each
-      episode re-trims for its drawn parameters (a few ms per reset).
+      the estimated parameters in ``aerostat_gym.envs.config.DEFAULT_RANDOMIZATION``; each
+      episode re-trims for its drawn parameters (a few ms per reset). Draws are independent
+      and uniform; moments of inertia no body has (a broken triangle inequality, about 11 % of
+      the default draws) are drawn again, and inertia ranges that give bodies less than 5 % of
+      the time are refused here.
     - ``obs_noise=0.0``: sensor noise std in scaled units. ``reward_weights=None``: dict of
       weights by term name. ``reward_fn=None``: a user reward ``f(obs, action, info) -> float``.
       ``observation="standard"`` or ``"full"``.
@@ -246,6 +249,13 @@ class TetheredAerostatEnv(gym.Env):
       default reward's displacement, length and velocity weights are divided by k^2, k^2 and k,
       k = L / 300 m (were the baseline's on every tether, so a 60 m aerostat's swing weighed
       25 times less against its pitch and effort terms than the baseline's).
+    - v0 (aerostat-gym 0.7.12; dynamics, observation and reward unchanged; what a randomised
+      episode draws changed): ``randomize`` draws again the moments of inertia no body has (a
+      broken triangle inequality, about 11 % of the default draws; were kept), and inertia
+      ranges whose draws are bodies less than 5 % of the time are a ``TaskError``. A seeded
+      start whose first draw is a body is bit-identical (19 of the 20 return seeds of
+      ``TetheredAerostatRealistic-v0``; seed 1001 draws again); a stream of unseeded resets
+      differs from its first redraw on. Unrandomised tasks are bit-identical.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}

@@ -6,7 +6,7 @@ Two tables exist in the package and they do not agree:
 * ``"documented"`` (default): the plausible ranges of :func:`aerostat_gym.analysis.sensitivity.
   default_knobs`, each with its source in the parameter notes (16 knobs, absolute ranges,
   derived knobs such as the CM shift and the air density with the net lift kept);
-* ``"randomization"``: :data:`aerostat_gym.envs.task.DEFAULT_RANDOMIZATION`, the relative
+* ``"randomization"``: :data:`aerostat_gym.envs.config.DEFAULT_RANDOMIZATION`, the relative
   half-ranges that ``randomize=True`` draws per episode (8 parameters, uniform in
   ``nominal * (1 +- rel)``).
 
