@@ -331,3 +331,32 @@ def test_recover_displacements_scale_with_the_tether():
     assert dx[lay.euler.start + 1] == pytest.approx(0.05 - turned, rel=1e-6)
     ep = run_scenario(PassivePolicy(), "recover", [10.0], [0], env_kwargs={"params": p})
     assert ep.x[0, 0] == pytest.approx(dx[lay.cm_pos.start], rel=1e-9)
+
+
+def test_baseline_design_tables_are_shared_and_equal_a_fresh_build():
+    """load_policy builds a model-based baseline's table once per design inputs and shares it:
+    the shared table equals one built anew to the last bit, and another sensor noise, control
+    step or parameter set gets its own."""
+    from aerostat_gym.agents.lqg import LQGSchedule
+    from aerostat_gym.agents.lqr import LQRSchedule
+    from aerostat_gym.agents.modal import ModalSchedule
+    from aerostat_gym.params import apply_overrides
+
+    lqr = load_policy("lqr").schedule
+    assert load_policy("lqr").schedule is lqr
+    assert np.array_equal(lqr.gains, LQRSchedule(load_params()).gains)
+    assert np.array_equal(load_policy("modal").schedule.gains,
+                          ModalSchedule(load_params()).gains)
+    noisy = load_policy("modal_lqg", obs_noise=0.01).schedule
+    assert load_policy("modal_lqg_shaped", obs_noise=0.01).policy.schedule is noisy
+    fresh = LQGSchedule(load_params(), obs_noise=0.01, gains="modal")
+    assert all(np.array_equal(noisy.tables[k], fresh.tables[k]) for k in fresh.tables)
+    # the filter follows the noise; the gains follow the design, not the noise
+    quiet = load_policy("modal_lqg", obs_noise=0.05).schedule
+    assert quiet is not noisy and not np.array_equal(quiet.tables["L"], noisy.tables["L"])
+    assert np.array_equal(quiet.tables["K"], noisy.tables["K"])
+    assert load_policy("lqg", obs_noise=0.01).schedule is not noisy
+    heavier = apply_overrides(load_params(), {"aerostat.mass": 1.01 * load_params().aerostat.mass})
+    assert load_policy("lqr", params=heavier).schedule is not lqr
+    with pytest.raises(ValueError, match="obs_noise must be a finite number >= 0, got 'x'"):
+        load_policy("lqg", obs_noise="x")

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import difflib
 import os
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -34,9 +35,9 @@ from ..envs.config import check_control_step
 from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION, as_batch, check_obs_noise
 from ..params import Params, as_params
 from ..resources import SHIPPED_POLICY, shipped_path
-from .lqg import LQGPolicy
-from .lqr import LQRPolicy
-from .modal import ModalPolicy
+from .lqg import LQGPolicy, LQGSchedule
+from .lqr import LQRPolicy, LQRSchedule, schedule_speeds
+from .modal import ModalPolicy, ModalSchedule
 from .residual import ShapedPolicy, check_residual, residual_shaper
 from .sb3io import PolicyError, load_sb3, to_actions
 
@@ -118,6 +119,31 @@ def shaped_command(policy, dt: float = 0.2, deadband: float = SHAPED_DEADBAND) -
     return ShapedPolicy(policy, deadband=deadband, lowpass=SHAPED_LOWPASS, dt=dt)
 
 
+#: Default design tables kept per process, by their design inputs (see :func:`default_schedule`).
+SCHEDULE_CACHE_SIZE = 16
+
+
+@lru_cache(maxsize=SCHEDULE_CACHE_SIZE)
+def default_schedule(kind: str, params: Params, dt: float, speeds: tuple | None = None,
+                     obs_noise: float = 0.0):
+    """The default design table of a model-based baseline: ``kind`` "lqr" (:class:`LQRSchedule`
+    over ``speeds``, None for its default speeds), "modal" (:class:`ModalSchedule`) or
+    "lqg" / "modal_lqg" (:class:`LQGSchedule` with the LQR's or the modal gains, filters for
+    ``obs_noise``).
+
+    A table trims, linearizes and designs at 15 wind speeds (1-2 s) and is a pure function of
+    these inputs (the parameter set compares by value), so it is built once per process and
+    shared: an evaluation loads each baseline once per scenario, and every saved residual
+    policy rebuilds its base. A shared table is read-only: the policies only read it, and code
+    that wants to change one builds its own (the policies take ``schedule=``)."""
+    if kind == "lqr":
+        return LQRSchedule(params, speeds=speeds, dt=dt)
+    if kind == "modal":
+        return ModalSchedule(params, dt=dt)
+    return LQGSchedule(params, dt=dt, obs_noise=obs_noise,
+                       gains="modal" if kind == "modal_lqg" else "lqr")
+
+
 def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
                 obs_noise: float = 0.0):
     """A baseline by name designed for ``params`` (a Params, a TOML path or a shipped
@@ -135,7 +161,8 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
 
     A saved model's wrapper metadata (``<stem>_wrappers.json``) is honoured: its frame stack,
     and its residual base rebuilt for ``params`` and ``dt`` with the sensor noise it was
-    trained with.
+    trained with. The model-based baselines' design tables come from :func:`default_schedule`:
+    built once per process for the same inputs and shared, read-only.
     """
     params = as_params(params, PolicyError)
     check_control_step(dt)  # the step the controllers are designed for
@@ -158,15 +185,14 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     if name == "tension":
         return TensionFeedbackPolicy.for_params(params)
     if name == "lqr":
-        return LQRPolicy(params, dt=dt, wind_range=wind_range)
+        speeds = None if wind_range is None else tuple(schedule_speeds(wind_range))
+        return LQRPolicy(params, dt=dt, schedule=default_schedule("lqr", params, float(dt), speeds))
     if name == "modal":
-        return ModalPolicy(params, dt=dt)
-    if name == "lqg":
-        return LQGPolicy(params, dt=dt, obs_noise=obs_noise)
-    if name == "modal_lqg":
-        return LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal")
+        return ModalPolicy(params, dt=dt, schedule=default_schedule("modal", params, float(dt)))
+    if name in ("lqg", "modal_lqg"):
+        return _lqg(name, params, dt, obs_noise)
     if name in ("modal_lqg_shaped", "modal_lqg_lowpass"):
-        return shaped_command(LQGPolicy(params, dt=dt, obs_noise=obs_noise, gains="modal"), dt,
+        return shaped_command(_lqg("modal_lqg", params, dt, obs_noise), dt,
                               SHAPED_DEADBAND if name == "modal_lqg_shaped" else 0.0)
     if name in SHIPPED:
         return load_sb3(shipped_path(SHIPPED[name]), residual_factory)
@@ -176,3 +202,10 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise PolicyError(f"unknown policy {name!r}{hint}: use one of "
                       f"{BASELINES + tuple(SHIPPED)} or a path to a .zip")
+
+
+def _lqg(kind: str, params: Params, dt: float, obs_noise) -> LQGPolicy:
+    """An LQG baseline ("lqg" or "modal_lqg") on the shared table for its sensor noise."""
+    noise = check_obs_noise(obs_noise)
+    return LQGPolicy(params, dt=dt, obs_noise=noise,
+                     schedule=default_schedule(kind, params, float(dt), None, noise))
