@@ -213,3 +213,30 @@ def test_nonlinear_damping_brake_logic_on(U, swing):
     run = swing_response(LQRPolicy(params, dt=DT, schedule=schedule), U, swing)
     assert run.ended is None
     assert run.zeta_drift == pytest.approx(pred, rel=0.20)
+
+
+def test_per_axis_cm_weights(params):
+    """The CM weight groups take one deviation per ground axis: three equal ones are the single
+    weight to the last bit (Q, and so K); an along-wind-only weight puts 1 / x^2 on the CM's x
+    alone and asks the loop for more reel on the along-wind position than the default does; a
+    malformed triple is refused naming the group."""
+    from aerostat_gym.agents.lqr import bryson_weights, design_lqr
+
+    one = design_lqr(params, 10.0, weights={"cm_pos": 2.0, "cm_vel": 0.2})
+    three = design_lqr(params, 10.0, weights={"cm_pos": (2.0, 2.0, 2.0),
+                                              "cm_vel": [0.2, 0.2, 0.2]})
+    assert np.array_equal(one.K, three.K)
+    lay = StateLayout(params.tether.n_elements)
+    w = dict(three.weights, cm_pos=(1.0, 5.0, 50.0))
+    q = np.diag(bryson_weights(lay, w)[0])[lay.cm_pos]
+    assert q == pytest.approx([1.0, 1 / 25.0, 1 / 2500.0], rel=1e-15)
+    along = design_lqr(params, 10.0, weights={"cm_pos": (1.0, 5.0, 50.0)})
+    default = design_lqr(params, 10.0)
+    x = lay.cm_pos.start
+    assert abs(along.K[x]) > abs(default.K[x])
+    for bad in ((1.0, 2.0), (1.0, -2.0, 3.0), (1.0, float("nan"), 3.0), "1 2 3"):
+        with pytest.raises(ValueError, match="LQR weight 'cm_pos' must be a finite positive"):
+            design_lqr(params, 10.0, weights={"cm_pos": bad})
+    with pytest.raises(ValueError, match="LQR weight 'length' must be a finite positive "
+                                         r"deviation, got \(1.0, 2.0, 3.0\)"):
+        design_lqr(params, 10.0, weights={"length": (1.0, 2.0, 3.0)})

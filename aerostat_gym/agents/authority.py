@@ -68,9 +68,17 @@ def _x_weighted(cm: float, length: float) -> dict:
     return {"cm_pos": cm, "cm_vel": cm / 10.0, "length": length}
 
 
+def _along_wind_only(x: float, length: float) -> dict:
+    # Bryson deviations per ground axis (x, y, z): the CM's along-wind position x [m] and
+    # velocity x/10, the cross-wind ones at their defaults (the winch cannot move them) and the
+    # height left free (50 m, 5 m/s). _x_weighted's single CM weight also holds the height, so
+    # its loop spends the reel on z as well; this one asks for x alone.
+    return {"cm_pos": (x, 5.0, 50.0), "cm_vel": (x / 10.0, 0.5, 5.0), "length": length}
+
+
 #: The sweep's family: the default modal schedule and three constant damping targets (from a
-#: mild one to nearly critical), the default LQR and three with ever tighter displacement
-#: weights and looser length weights.
+#: mild one to nearly critical), the default LQR, three with ever tighter displacement
+#: weights and looser length weights, and one weighted on the along-wind displacement alone.
 DESIGNS = (
     Design("modal", "modal"),
     Design("modal zeta 0.4", "modal", zeta=0.4),
@@ -80,6 +88,7 @@ DESIGNS = (
     Design("lqr x 2 m", "lqr", weights=_x_weighted(2.0, 5.0)),
     Design("lqr x 1 m", "lqr", weights=_x_weighted(1.0, 10.0)),
     Design("lqr x 0.5 m", "lqr", weights=_x_weighted(0.5, 20.0)),
+    Design("lqr along-wind 1 m", "lqr", weights=_along_wind_only(1.0, 20.0)),
 )
 
 #: (metric, factor on passive's value): a design meets the target where its value is at most

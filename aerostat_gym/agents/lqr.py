@@ -57,6 +57,7 @@ from ..analysis.modes import (
     modes_from_eig,
 )
 from ..analysis.trim import Equilibrium, find_equilibrium
+from ..checks import is_finite_number
 from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND, as_batch
 from ..params import Params, dumps_toml
 from ..physics.state import StateLayout
@@ -68,7 +69,9 @@ from .swing_plane import in_swing_plane
 #: damping to it; pitch 0.1 rad and pitch rate 0.05 rad/s keep the pitch gains at a few
 #: (m/s)/rad (0.05 rad and 0.02 rad/s give gains near 20 (m/s)/(rad/s) at 5 m/s, which chatter
 #: the winch on pitch oscillations and ride its 0.5 m/s^2 acceleration limit). Tether nodes get
-#: small weights: their motion follows the aerostat's and the winch cannot shape it.
+#: small weights: their motion follows the aerostat's and the winch cannot shape it. An
+#: override of the CM groups may give one deviation per axis, (x, y, z) in the ground frame:
+#: a design can then weight the along-wind displacement alone and leave the height free.
 LQR_MAX_DEVIATIONS: dict[str, float | None] = {
     "node_pos": 50.0,  # m, every moving tether node, x y z
     "node_vel": 10.0,  # m/s
@@ -191,16 +194,32 @@ def scaled_deviations(params: Params) -> dict:
     return w
 
 
+#: Weight groups that take one deviation per ground axis (x, y, z) as well as one for all three.
+PER_AXIS_WEIGHTS = ("cm_pos", "cm_vel")
+
+
+def _deviation(v) -> bool:
+    return is_finite_number(v) and v > 0
+
+
 def _weights(params: Params, weights: dict | None) -> dict:
     w = scaled_deviations(params)
     for k, v in (weights or {}).items():
         if k not in w:
             raise ValueError(f"unknown LQR weight {k!r}; known: {', '.join(w)}")
         w[k] = v
+    out = {}
     for k, v in w.items():
-        if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
+        if k in PER_AXIS_WEIGHTS and isinstance(v, list | tuple):
+            if not (len(v) == 3 and all(_deviation(a) for a in v)):
+                raise ValueError(f"LQR weight {k!r} must be a finite positive deviation or three "
+                                 f"of them (x, y, z), got {v!r}")
+            out[k] = tuple(float(a) for a in v)
+        elif _deviation(v):
+            out[k] = float(v)
+        else:
             raise ValueError(f"LQR weight {k!r} must be a finite positive deviation, got {v!r}")
-    return {k: float(v) for k, v in w.items()}
+    return out
 
 
 def bryson_weights(layout: StateLayout, weights: dict) -> tuple[np.ndarray, np.ndarray]:
