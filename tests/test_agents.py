@@ -10,6 +10,9 @@ import numpy as np
 import pytest
 
 from aerostat_gym.agents.evaluate import evaluate_policy, run_scenario
+from aerostat_gym.agents.lqg import LQGSchedule
+from aerostat_gym.agents.lqr import LQRSchedule
+from aerostat_gym.agents.modal import ModalSchedule
 from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy, load_policy
 from aerostat_gym.agents.report import comparison_table, lqr_predictions
 from aerostat_gym.agents.sb3io import PolicyError
@@ -17,7 +20,7 @@ from aerostat_gym.agents.train import train
 from aerostat_gym.analysis.reference import closed_form_periods
 from aerostat_gym.cli import main
 from aerostat_gym.envs.spaces import N_OBS
-from aerostat_gym.params import load_params
+from aerostat_gym.params import apply_overrides, load_params
 from aerostat_gym.resources import shipped_path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -337,11 +340,6 @@ def test_baseline_design_tables_are_shared_and_equal_a_fresh_build():
     """load_policy builds a model-based baseline's table once per design inputs and shares it:
     the shared table equals one built anew to the last bit, and another sensor noise, control
     step or parameter set gets its own."""
-    from aerostat_gym.agents.lqg import LQGSchedule
-    from aerostat_gym.agents.lqr import LQRSchedule
-    from aerostat_gym.agents.modal import ModalSchedule
-    from aerostat_gym.params import apply_overrides
-
     lqr = load_policy("lqr").schedule
     assert load_policy("lqr").schedule is lqr
     assert np.array_equal(lqr.gains, LQRSchedule(load_params()).gains)

@@ -13,6 +13,7 @@ from aerostat_gym.agents.frontier import swing_response
 from aerostat_gym.agents.lqr import (
     LQRPolicy,
     LQRSchedule,
+    bryson_weights,
     design_lqr,
     mode_initial_state,
     set_point_law,
@@ -220,8 +221,6 @@ def test_per_axis_cm_weights(params):
     weight to the last bit (Q, and so K); an along-wind-only weight puts 1 / x^2 on the CM's x
     alone and asks the loop for more reel on the along-wind position than the default does; a
     malformed triple is refused naming the group."""
-    from aerostat_gym.agents.lqr import bryson_weights, design_lqr
-
     one = design_lqr(params, 10.0, weights={"cm_pos": 2.0, "cm_vel": 0.2})
     three = design_lqr(params, 10.0, weights={"cm_pos": (2.0, 2.0, 2.0),
                                               "cm_vel": [0.2, 0.2, 0.2]})

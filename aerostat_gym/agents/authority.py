@@ -71,8 +71,8 @@ def _x_weighted(cm: float, length: float) -> dict:
 def _along_wind_only(x: float, length: float) -> dict:
     # Bryson deviations per ground axis (x, y, z): the CM's along-wind position x [m] and
     # velocity x/10, the cross-wind ones at the baseline's defaults (5 m, 0.5 m/s: the winch
-    # cannot move them) and the height left free (50 m, 5 m/s). _x_weighted's single CM weight also holds the height, so
-    # its loop spends the reel on z as well; this one asks for x alone.
+    # cannot move them) and the height left free (50 m, 5 m/s). _x_weighted's single CM weight
+    # also holds the height, so its loop spends the reel on z as well; this one asks for x alone.
     return {"cm_pos": (x, 5.0, 50.0), "cm_vel": (x / 10.0, 0.5, 5.0), "length": length}
 
 
