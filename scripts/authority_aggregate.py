@@ -65,6 +65,7 @@ def main(argv=None) -> dict:
     cache = Path(args.episodes) if args.episodes else None
     if cache is not None and cache.is_file():
         designs = json.loads(cache.read_text())
+    cached = len(designs)
     # the default modal and LQR designs are the baselines of those names (the same episodes,
     # tests/test_authority.py), so only the other designs run
     for d in DESIGNS:
@@ -84,7 +85,9 @@ def main(argv=None) -> dict:
             "# The aggregate with the privileged full state\n\n`PYTHONPATH=. python "
             "scripts/authority_aggregate.py <baselines' report.json>`: every authority-sweep "
             "design on every report cell (20 seeds, the report's turbulence and noise; the "
-            f"designs read the noise-free state), {wall:.0f} s. The default `modal` and `lqr` "
+            f"designs read the noise-free state, a tension relief the noisy load cell), {wall:.0f} s"
+            + (f" ({cached} designs' episodes read from the --episodes cache)" if cached else "")
+            + ". The default `modal` and `lqr` "
             "designs are the baselines of those names. P(> X): probability that the design "
             "beats baseline X on a random cell and seed.\n\n" + md + "\n")
     if args.json:

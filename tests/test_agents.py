@@ -13,7 +13,12 @@ from aerostat_gym.agents.evaluate import evaluate_policy, run_scenario
 from aerostat_gym.agents.lqg import LQGSchedule
 from aerostat_gym.agents.lqr import LQRSchedule
 from aerostat_gym.agents.modal import ModalSchedule
-from aerostat_gym.agents.policies import PassivePolicy, TensionFeedbackPolicy, load_policy
+from aerostat_gym.agents.policies import (
+    PassivePolicy,
+    TensionFeedbackPolicy,
+    TensionRelief,
+    load_policy,
+)
 from aerostat_gym.agents.report import comparison_table, lqr_predictions
 from aerostat_gym.agents.sb3io import PolicyError
 from aerostat_gym.agents.train import train
@@ -37,6 +42,30 @@ def test_baselines_have_sb3_predict_signature():
         assert a1.shape == (1,)
     a, _ = TensionFeedbackPolicy(gain=0.3).predict(obs)
     assert np.allclose(a, 0.6)  # 0.3 m/s per kN x 2 kN = 0.6 m/s of a 1 m/s winch
+
+
+def test_tension_relief_pays_out_on_tension_above_trim_only():
+    """TensionRelief adds relief x max(T - T_trim, 0) / (B - m g) to its base's action: 2.5 top
+    speeds per net lift on the baseline (net lift 2644.7 N) pays out 0.5 kN / 2644.7 N x 2.5 =
+    0.4726 of the top speed on a 0.5 kN excess, nothing below trim, and clips at the winch's
+    limit; its base's recurrent state passes through, and a negative or non-finite gain is
+    refused at the door."""
+    params = load_params()
+    net_lift = params.derived.net_lift
+    assert net_lift == pytest.approx(2644.7, abs=0.1)
+    obs = np.zeros((4, N_OBS), np.float32)
+    obs[:, 13] = (0.5, -0.5, 2.0, 0.0)  # tension minus trim [kN]
+    relieved = TensionRelief(TensionFeedbackPolicy(gain=0.3), params, 2.5)
+    a, state = relieved.predict(obs, state="kept")
+    expected = 0.3 * obs[:, 13] + 2.5 * np.maximum(obs[:, 13] * 1e3, 0.0) / net_lift
+    assert a[:, 0] == pytest.approx(np.clip(expected, -1.0, 1.0), abs=1e-6)
+    assert a[0, 0] == pytest.approx(0.15 + 0.4726, abs=1e-4) and a[2, 0] == 1.0
+    assert state == "kept"
+    a0, _ = TensionRelief(PassivePolicy(), params, 2.5).predict(obs[1])
+    assert a0.shape == (1,) and a0[0] == 0.0
+    for bad in (-0.1, math.nan, math.inf):
+        with pytest.raises(ValueError, match="tension relief"):
+            TensionRelief(PassivePolicy(), params, bad)
 
 
 def test_passive_recovery_damping_matches_linear_model():

@@ -3,7 +3,8 @@ deterministic)`` signature, so one evaluator runs baselines and trained models a
 
 - :class:`PassivePolicy`: action 0, which engages the winch brake (the paper's fixed tether).
 - :class:`TensionFeedbackPolicy`: a compliant winch, reeling out when the tension exceeds its
-  trim value and back in slowly toward the trim length.
+  trim value and back in slowly toward the trim length; :class:`TensionRelief` adds a one-sided
+  relief of that kind to another policy's command.
 - :class:`aerostat_gym.agents.lqr.LQRPolicy`: gain-scheduled LQR on the linear model
   (privileged full state); :class:`aerostat_gym.agents.modal.ModalPolicy` the same with the
   modal gains.
@@ -110,6 +111,32 @@ class TensionFeedbackPolicy:
         dL = obs[:, OBS_DLENGTH] * CHANNELS[OBS_DLENGTH].scale
         v = self.gain * dT_kN - dL / self.restore_time
         return to_actions(v / self.max_speed, single), state
+
+
+class TensionRelief:
+    """``base`` with a one-sided tension relief added to its command: the winch pays out at
+    ``relief`` x its top speed per net lift of tension above trim, v = v_base + relief x
+    v_max x max(T - T_trim, 0) / (B - m g), clipped to the winch limit; below trim the base
+    acts alone.
+
+    The relief reads the load-cell channel (``dtension``, with the sensor's noise), as a
+    slip-clutch or tension-limited winch does. It takes the gust's pull off the tether rather
+    than reeling against it, and leaves the base's recurrent state to the base.
+    """
+
+    def __init__(self, base, params: Params, relief: float):
+        if not (np.isfinite(relief) and relief >= 0.0):
+            raise ValueError(f"tension relief must be a finite gain >= 0 (winch top speeds per "
+                             f"net lift), got {relief!r}")
+        self.base, self.relief = base, float(relief)
+        self.net_lift = float(params.derived.net_lift)
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        actions, state = self.base.predict(observation, state, episode_start, deterministic)
+        obs, single = as_batch(observation, float)
+        excess = np.maximum(obs[:, OBS_DTENSION] * CHANNELS[OBS_DTENSION].scale, 0.0)
+        a = np.asarray(actions, float).reshape(-1) + self.relief * excess / self.net_lift
+        return to_actions(a, single), state
 
 
 def shaped_command(policy, dt: float = 0.2, deadband: float = SHAPED_DEADBAND) -> ShapedPolicy:
