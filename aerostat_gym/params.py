@@ -6,7 +6,8 @@ baseline value (SOURCED, DERIVED, ESTIMATE, CALIB) in its dataclass metadata, so
 ``parameter_table()`` can tell a user which numbers are measured and which are guesses.
 
 Loading is strict: an unknown key, a missing key or section, a wrong type or an impossible
-value raises :class:`ParameterError` naming the field and the value. Quantities that follow
+value raises :class:`ParameterError` naming the field and the value; :func:`load_params` also
+refuses values no real aerostat has (unit slips, :func:`check_plausibility`). Quantities that follow
 from the inputs (buoyancy, net lift, leash x_l, EA, element mass, tether damping, added masses)
 are computed in :class:`Derived`, never typed in.
 """
@@ -355,6 +356,7 @@ def _cross_checks(p: Params) -> None:
             f"<= weight {p.aerostat.mass * p.environment.g:.1f} N)"
         )
     _feasibility(p, d)
+    check_limits(p)
 
 
 class InertiaError(ParameterError):
@@ -485,6 +487,9 @@ def _advise(p: Params, source: str) -> None:
     for text in hull_integral_warnings(p):
         warnings.warn(f"{source}: {text}: check the hull integrals (docs/parameters.md, "
                       "section 1c)", ParameterWarning, stacklevel=3)
+    for text in plausibility_warnings(p):
+        warnings.warn(f"{source}: {text} (docs/parameters.md, section 1k)", ParameterWarning,
+                      stacklevel=3)
 
 
 def hull_integral_warnings(p: Params) -> list[str]:
@@ -502,6 +507,300 @@ def hull_integral_warnings(p: Params) -> list[str]:
         out.append(f"hull.J2 / hull.J1 = {h.J2 / h.J1:.4g} m, the centroid of the hull's side "
                    f"area, lies outside the hull region [0, hull.l_h = {h.l_h:g}] m")
     return out
+
+
+# --- plausibility: values that pass their own field's check but no real aerostat has -----------
+#
+# A unit slip (MPa written as Pa, cm as m) passes every per-field check and the feasibility
+# checks, loads, and then fails every episode at step 0 far from its cause. The bounds below are
+# refused at the door (:func:`check_plausibility`, run by load_params on the file and its
+# overrides alike); values that are unusual but possible only warn (:func:`plausibility_warnings`,
+# a ParameterWarning). Every bound is generous: aerostats from 5 m to 70 m hulls, tethers from
+# 20 m to 5 km of Dyneema, Kevlar, Vectran, polyester or steel-armoured conductor cable all pass.
+# They are not checked by Params.replace / apply_overrides, so that studies may still move one
+# value past them on purpose (a weightless tether, RK4 past its stability bound).
+
+
+class ImplausibleParameterError(ParameterError):
+    """A value that passes its field's own check but no real aerostat or tether has, most often
+    a unit slip; the message names the field, the value, the bound and the likely slip."""
+
+
+#: Largest number of fin panels: the compiled core packs the panels into a fixed-size block
+#: (aerostat_gym.physics.packing.MAX_FINS, which must equal this; tests check it). params sits
+#: below the physics layer, so the constant is mirrored here rather than imported.
+MAX_FIN_PANELS = 6
+#: [m/s] the fastest mean wind the model is defined for (aerostat_gym.physics.wind.MAX_WIND_SPEED,
+#: which must equal this; tests check it): the aerodynamics are incompressible, valid below
+#: Mach 0.3, about 100 m/s at sea level. README "Guarantees": a faster mean wind is refused.
+MAX_WIND_SPEED = 100.0
+#: simulation.rk4_safety above this is past the measured stability edge of the RK4 step
+#: (aerostat_gym.physics.integrators.rk4_step: runs at 1.02 times the bound 2 sqrt(2) / omega_max
+#: stay stable, the element damping moving the axial eigenvalues off the imaginary axis; beyond
+#: that the axial tether modes leave RK4's stability region and every episode diverges).
+RK4_SAFETY_LIMIT = 1.02
+#: simulation.semi_implicit_dt above this many times the advised step is refused: the steps
+#: that failed in the calibration of TETHER_DRAG_REFERENCE_SPEED and of the Froude-scaled
+#: step began at 1.2 x (h lambda 2.0 at 12.5 m/s) and 1.5 x (50 ms on the baseline scaled to
+#: 0.1 x its volume, advised 34 ms) the advised step; past twice it no episode in strong wind
+#: can be trusted, and a break from a blown-up step would read as physics.
+SEMI_IMPLICIT_REFUSE_FACTOR = 2.0
+#: Strain of the tether at its breaking strength, tether.strength / EA. Fibre ropes break at a
+#: few % (HMPE/Dyneema 3-4 %, aramid/Kevlar 2-4 %, Vectran 3-5 %, steel 1-2 %, polyester
+#: 12-15 %); nylon, the stretchiest rope fibre, at 20-40 %. Above WARN: unusual (a nylon-like
+#: line); above MAX: no rope stretches to twice its length before breaking.
+TETHER_BREAK_STRAIN_WARN = 0.25
+TETHER_BREAK_STRAIN_MAX = 1.0
+#: Strain of the tether under the still-air net lift, net lift / EA: a tether is loaded at a
+#: fraction of its strength, so a real one stretches well under 10 %; a modulus so low that
+#: the net lift stretches the line by half its length is a unit slip.
+TETHER_LIFT_STRAIN_MAX = 0.5
+#: [Pa] diamond's Young's modulus is about 1.05e12 Pa; no tether is stiffer (steel 2.0e11,
+#: carbon fibre up to 6e11, HMPE fibre 1.1e11).
+TETHER_MODULUS_MAX = 1.2e12
+#: [kg/m^3] the tether's effective density, mass per length / (pi d^2 / 4). Rope fibres range
+#: from polypropylene's 910 (HMPE 970, aramid 1440, polyester 1380) to steel's 7850 and copper's
+#: 8960; a braid's voids take the effective value down to about half. Outside WARN: unusual;
+#: outside MAX: no solid is that light (a foam rope is still > 50) or heavier than tungsten.
+TETHER_DENSITY_WARN = (400.0, 9000.0)
+TETHER_DENSITY_MAX = (50.0, 20000.0)
+#: Prismatic coefficient volume / (pi d^2 L / 4), the hull's share of the cylinder enclosing it.
+#: Convex bodies of revolution lie between the double cone's 1/3 and the cylinder's 1; helium
+#: fins can add a few %. Streamlined hulls have 0.55-0.7 (an ellipsoid 0.667, the baseline
+#: 0.609). Outside WARN: unusual; outside MAX: a unit slip (d in cm shrinks it 10^4-fold).
+HULL_PRISMATIC_WARN = (0.4, 0.85)
+HULL_PRISMATIC_MAX = (0.25, 1.1)
+#: Fineness ratio length / diameter: a spherical balloon has 1, aerostats 2.2-4, the slimmest
+#: airships about 8 (ZR-3 7.3). Below MIN the hull is shorter than its diameter (length and
+#: diameter swapped?); above WARN unusual; above MAX no hull.
+HULL_FINENESS_MIN, HULL_FINENESS_WARN, HULL_FINENESS_MAX = 0.9, 8.0, 20.0
+#: A fin's quarter-chord mid-span point may sit this many hull lengths aft of the tail (fins
+#: overhanging the tail on a short hull), and at most this many diameters off the hull axis
+#: (the baseline's fins: 0.6 D; the span of an aerostat fin is at most about a diameter).
+FIN_AFT_OF_TAIL = 0.25
+FIN_RADIUS_MAX = 2.0
+#: The confluence point hangs at most this many hull lengths below the CM (the [LN02] rule puts
+#: it 1.5 D below the axis, 0.63 L on the baseline; long flying lines reach about a hull length).
+LEASH_DEPTH_MAX = 3.0
+#: hull.Cdc: the cross-flow drag coefficient of the hull's sections; a circular cylinder has
+#: 0.3-1.2 (super- to subcritical), a flat plate 2.0, a concave half-cylinder face 2.3, the
+#: largest of any section. Above WARN: unusual; above MAX: no section.
+HULL_CDC_WARN, HULL_CDC_MAX = 1.5, 3.0
+
+
+def _slip(value: float, factors: dict[str, float], ok) -> str:
+    """``; looks like <slip>`` for the first unit slip whose correction factor makes ``ok``
+    true, or an empty string."""
+    for text, factor in factors.items():
+        if ok(value * factor):
+            return f"; looks like {text}"
+    return ""
+
+
+def _div(a: float, b: float) -> float:
+    """a / b for a >= 0, b >= 0 that underflowed or overflowed: inf where b is 0 (a bound then
+    refuses it instead of a ZeroDivisionError)."""
+    return a / b if b > 0.0 else math.inf
+
+
+def check_limits(p: Params) -> None:
+    """Limits of the compiled core and of the model's validity, checked on every load and
+    override: at most MAX_FIN_PANELS fin panels, a mean wind of at most MAX_WIND_SPEED, and the
+    winch on or above the ground (heights are measured from the ground, z = 0)."""
+    n = len(p.fins.panels)
+    if n > MAX_FIN_PANELS:
+        raise ParameterError(f"fins.panels has {n} panels; at most {MAX_FIN_PANELS} fin panels "
+                             "are supported (the compiled core's fixed fin block)")
+    if p.wind.speed > MAX_WIND_SPEED:
+        raise ParameterError(
+            f"wind.speed = {p.wind.speed:g} m/s exceeds {MAX_WIND_SPEED:g} m/s, the fastest mean "
+            "wind the model is defined for (incompressible aerodynamics, Mach < 0.3)"
+            + _slip(p.wind.speed, {"km/h written as m/s": 1 / 3.6}, lambda v: v <= MAX_WIND_SPEED))
+    z0 = p.tether.anchor_position[2]
+    if z0 < 0.0:
+        raise ParameterError(
+            f"tether.anchor_position = {list(p.tether.anchor_position)} puts the winch at "
+            f"z = {z0:g} m, below the ground (z = 0): its z must be >= 0 (the wind profile and "
+            "the ground strike read heights above the ground)")
+
+
+def check_plausibility(p: Params) -> None:
+    """Refuse values that load but no real aerostat has (:class:`ImplausibleParameterError`),
+    naming the field, the value, the bound and the likely slip. Run by :func:`load_params`."""
+    a, t, d = p.aerostat, p.tether, p.derived
+    E = t.youngs_modulus
+    # tether: its stretch under its own breaking strength and under the net lift
+    break_strain, lift_strain = _div(t.strength, d.EA), _div(d.net_lift, d.EA)
+    if E > TETHER_MODULUS_MAX:
+        raise ImplausibleParameterError(
+            f"tether.youngs_modulus = {E:g} Pa exceeds {TETHER_MODULUS_MAX:g} Pa, stiffer than "
+            "diamond" + _slip(E, {"kPa written as Pa": 1e-3, "MPa written as Pa": 1e-6},
+                              lambda v: v <= TETHER_MODULUS_MAX))
+    if break_strain > TETHER_BREAK_STRAIN_MAX or lift_strain > TETHER_LIFT_STRAIN_MAX:
+        ok = lambda v: (_div(t.strength, v * d.tether_area) <= TETHER_BREAK_STRAIN_WARN  # noqa: E731
+                        and _div(d.net_lift, v * d.tether_area) <= TETHER_LIFT_STRAIN_MAX)
+        raise ImplausibleParameterError(
+            f"tether.youngs_modulus = {E:g} Pa gives EA = {d.EA:.4g} N on the "
+            f"{1000 * t.diameter:g} mm tether (tether.diameter): it would stretch by "
+            f"{100 * lift_strain:.3g} % under the net lift ({d.net_lift:.1f} N) and by "
+            f"{100 * break_strain:.3g} % at tether.strength ({t.strength:g} N); a real tether "
+            f"stretches a few % at break (bounds: {100 * TETHER_LIFT_STRAIN_MAX:g} % under the "
+            f"net lift, {100 * TETHER_BREAK_STRAIN_MAX:g} % at break)"
+            + _slip(E, {"MPa written as Pa": 1e6, "GPa written as Pa": 1e9,
+                        "GPa written as MPa": 1e3}, ok))
+    rho_t = t.density
+    lo, hi = TETHER_DENSITY_MAX
+    if not lo <= rho_t <= hi:
+        raise ImplausibleParameterError(
+            f"tether.density = {rho_t:g} kg/m^3 (a {1000 * d.mass_per_length:.4g} g/m line at "
+            f"tether.diameter = {1000 * t.diameter:g} mm) lies outside [{lo:g}, {hi:g}] kg/m^3, "
+            "the effective density of any rope or cable (it is the material density, kg/m^3, "
+            "not the mass per length)"
+            + _slip(rho_t, {"g/cm^3 written as kg/m^3": 1e3, "kg/m (mass per length) written "
+                            "as kg/m^3": 1.0 / d.tether_area}, lambda v: lo <= v <= hi))
+    # hull: length, diameter and volume must describe one body
+    cyl = math.pi / 4.0 * a.diameter * a.diameter * a.length  # inf, not OverflowError
+    prismatic, fineness = _div(a.volume, cyl), _div(a.length, a.diameter)
+    lo, hi = HULL_PRISMATIC_MAX
+    if not lo <= prismatic <= hi:
+        raise ImplausibleParameterError(
+            f"aerostat.volume = {a.volume:g} m^3 is {prismatic:.3g} times the cylinder "
+            f"pi d^2 L / 4 = {cyl:.4g} m^3 enclosing aerostat.length = {a.length:g} m and "
+            f"aerostat.diameter = {a.diameter:g} m; a hull fills {lo:g}..{hi:g} of it "
+            "(streamlined hulls 0.55-0.7)"
+            + _slip(prismatic, {"aerostat.diameter in cm": 1e4, "aerostat.length in cm": 1e2,
+                                "aerostat.diameter in mm": 1e6, "aerostat.volume in litres": 1e-3,
+                                "aerostat.diameter written as the radius": 0.25},
+                    lambda v: lo <= v <= hi))
+    if not HULL_FINENESS_MIN <= fineness <= HULL_FINENESS_MAX:
+        raise ImplausibleParameterError(
+            f"aerostat.length / aerostat.diameter = {a.length:g} / {a.diameter:g} = "
+            f"{fineness:.3g} lies outside [{HULL_FINENESS_MIN:g}, {HULL_FINENESS_MAX:g}] (a "
+            "sphere has 1, aerostats 2.2-4, the slimmest airships about 8)"
+            + ("; looks like length and diameter swapped" if fineness < 1 else ""))
+    # body points: x-z symmetry, and inside the hull's length envelope
+    L, D = a.length, a.diameter
+    x_nose, y_nose, z_axis = a.nose_position
+    tol = 1e-6 * L  # rounding of a point written in the symmetry plane
+    for name, y in (("aerostat.cb_position", a.cb_position[1]), ("aerostat.nose_position", y_nose)):
+        if abs(y) > tol:
+            raise ImplausibleParameterError(
+                f"{name} = {list(getattr(a, name.split('.')[1]))} has y = {y:g} m: the model "
+                "assumes the x-z plane through the CM is a plane of symmetry (Ixy = Iyz = 0, "
+                "leash point at y = 0), so the CB and the nose need y = 0")
+    if not 0.0 < x_nose < L:
+        raise ImplausibleParameterError(
+            f"aerostat.nose_position x = {x_nose:g} m puts the CM "
+            + ("ahead of the nose" if x_nose <= 0 else f"{x_nose - L:g} m behind the tail")
+            + f" of the aerostat.length = {L:g} m hull: the nose must lie 0 < x < {L:g} m ahead "
+            "of the CM" + ("; looks like the sign was flipped (x points to the nose)"
+                           if 0 < -x_nose < L else ""))
+    x_tail = x_nose - L
+    if not x_tail <= a.cb_position[0] <= x_nose:
+        raise ImplausibleParameterError(
+            f"aerostat.cb_position x = {a.cb_position[0]:g} m lies outside the hull, which runs "
+            f"from the tail at x = {x_tail:g} m to the nose at x = {x_nose:g} m "
+            "(aerostat.nose_position, aerostat.length)")
+    for i, pan in enumerate(p.fins.panels):
+        x, y, z = pan.cp_position
+        aft = x_tail - FIN_AFT_OF_TAIL * L
+        if not aft <= x <= x_nose:
+            raise ImplausibleParameterError(
+                f"fins.panels[{i}].cp_position x = {x:g} m lies outside [{aft:g}, {x_nose:g}] m: "
+                f"the hull runs from x = {x_tail:g} m (tail) to {x_nose:g} m (nose, "
+                f"aerostat.nose_position, aerostat.length = {L:g} m), and a fin may sit at most "
+                f"{FIN_AFT_OF_TAIL:g} hull lengths aft of the tail")
+        r = math.hypot(y, z - z_axis)
+        if r > FIN_RADIUS_MAX * D:
+            raise ImplausibleParameterError(
+                f"fins.panels[{i}].cp_position = {list(pan.cp_position)} lies {r:.4g} m from the "
+                f"hull axis (z = {z_axis:g} m, aerostat.nose_position), more than "
+                f"{FIN_RADIUS_MAX:g} x aerostat.diameter = {FIN_RADIUS_MAX * D:g} m")
+    zl = a.leash_z
+    if zl >= 0.0:
+        raise ImplausibleParameterError(
+            f"aerostat.leash_z = {zl:g} m puts the confluence point at or above the CM; body z "
+            "points up, and the confluence point hangs below the hull: leash_z must be < 0"
+            + ("; looks like the sign was flipped" if zl <= LEASH_DEPTH_MAX * L else ""))
+    if -zl > LEASH_DEPTH_MAX * L:
+        raise ImplausibleParameterError(
+            f"aerostat.leash_z = {zl:g} m puts the confluence point {-zl / L:.3g} hull lengths "
+            f"below the CM (bound {LEASH_DEPTH_MAX:g} x aerostat.length = {LEASH_DEPTH_MAX * L:g}"
+            " m; the [LN02] rule is 1.5 diameters below the axis)"
+            + _slip(zl, {"cm written as m": 0.01}, lambda v: -v <= LEASH_DEPTH_MAX * L))
+    # aerodynamics and numerics
+    if p.hull.Cdc > HULL_CDC_MAX:
+        raise ImplausibleParameterError(
+            f"hull.Cdc = {p.hull.Cdc:g} exceeds {HULL_CDC_MAX:g}: no cross-section has a "
+            "cross-flow drag coefficient above about 2.3 (circular cylinders 0.3-1.2, a flat "
+            "plate 2.0)")
+    s = p.simulation.rk4_safety
+    if s > RK4_SAFETY_LIMIT:
+        raise ImplausibleParameterError(
+            f"simulation.rk4_safety = {s:g} exceeds {RK4_SAFETY_LIMIT:g}, the measured stability "
+            "limit: it is the fraction of the RK4 stability bound 2 sqrt(2) / omega_max used as "
+            "the step, so every rk4 episode would diverge (the shipped files use 0.9)"
+            + ("; looks like a percentage written as a fraction" if s >= 10.0
+               and s / 100.0 <= RK4_SAFETY_LIMIT else ""))
+    dt, advised = p.simulation.semi_implicit_dt, advised_semi_implicit_dt(p)
+    if dt > SEMI_IMPLICIT_REFUSE_FACTOR * advised:
+        raise ImplausibleParameterError(
+            f"simulation.semi_implicit_dt = {dt:g} s is more than {SEMI_IMPLICIT_REFUSE_FACTOR:g} x "
+            f"the {advised:.3g} s advised for this aerostat (params.advised_semi_implicit_dt), past "
+            "the measured edge where the step fails (1.2-1.5 x): an unstable step can load the "
+            "tether past its strength, and such a break could not be told from a real one. Set "
+            f"simulation.semi_implicit_dt <= {advised:.3g} (a step up to "
+            f"{SEMI_IMPLICIT_REFUSE_FACTOR:g} x loads with a warning)")
+
+
+def plausibility_warnings(p: Params) -> list[str]:
+    """Values that are unusual but possible (a ParameterWarning each at load)."""
+    a, t, d = p.aerostat, p.tether, p.derived
+    out = []
+    strain = _div(t.strength, d.EA)
+    if strain > TETHER_BREAK_STRAIN_WARN:
+        out.append(f"tether.youngs_modulus = {t.youngs_modulus:g} Pa stretches the tether by "
+                   f"{100 * strain:.3g} % at tether.strength = {t.strength:g} N, more than a "
+                   f"nylon rope's (HMPE, aramid and steel break at 1-5 %; warning above "
+                   f"{100 * TETHER_BREAK_STRAIN_WARN:g} %)")
+    lo, hi = TETHER_DENSITY_WARN
+    if not lo <= t.density <= hi:
+        out.append(f"tether.density = {t.density:g} kg/m^3 ({1000 * d.mass_per_length:.4g} g/m "
+                   f"at tether.diameter = {1000 * t.diameter:g} mm) lies outside "
+                   f"[{lo:g}, {hi:g}] kg/m^3, the effective density of fibre ropes and "
+                   "steel-armoured cables")
+    lo, hi = HULL_PRISMATIC_WARN
+    prismatic = _div(a.volume, math.pi / 4.0 * a.diameter * a.diameter * a.length)
+    if not lo <= prismatic <= hi:
+        out.append(f"aerostat.volume = {a.volume:g} m^3 is {prismatic:.3g} of the cylinder "
+                   "enclosing aerostat.length and aerostat.diameter (streamlined hulls: "
+                   f"0.55-0.7; warning outside [{lo:g}, {hi:g}])")
+    fineness = _div(a.length, a.diameter)
+    if fineness > HULL_FINENESS_WARN:
+        out.append(f"aerostat.length / aerostat.diameter = {fineness:.3g} is slimmer than any "
+                   f"airship (warning above {HULL_FINENESS_WARN:g})")
+    if p.hull.Cdc > HULL_CDC_WARN:
+        out.append(f"hull.Cdc = {p.hull.Cdc:g} is above a circular cylinder's 0.3-1.2 "
+                   f"(warning above {HULL_CDC_WARN:g})")
+    out.extend(_fin_symmetry_warnings(p))
+    return out
+
+
+def _fin_symmetry_warnings(p: Params) -> list[str]:
+    """Fin panels without a mirror image in the x-z plane (cp (x, -y, z), roll angle -phi): the
+    forces are computed panel by panel, so such a set runs, but the linear analyses and the
+    trim in the x-z plane assume the aerostat's symmetry."""
+    panels, L = p.fins.panels, p.aerostat.length
+
+    def mirrored(a: FinPanel, b: FinPanel) -> bool:
+        (xa, ya, za), (xb, yb, zb) = a.cp_position, b.cp_position
+        dphi = (a.roll_angle_deg + b.roll_angle_deg + 180.0) % 360.0 - 180.0
+        return (max(abs(xa - xb), abs(ya + yb), abs(za - zb)) <= 1e-3 * L and abs(dphi) <= 0.5)
+
+    return [f"fins.panels[{i}] ({pan.name!r}, cp_position {list(pan.cp_position)}, "
+            f"roll_angle_deg {pan.roll_angle_deg:g}) has no mirror panel in the x-z plane "
+            "(cp_position with -y, roll_angle_deg negated): the model assumes x-z symmetry"
+            for i, pan in enumerate(panels) if not any(mirrored(pan, q) for q in panels)]
 
 
 def check_length_within_winch(p: Params) -> None:
@@ -606,7 +905,8 @@ def _config_text(path: str | Path | None) -> tuple[str, str]:
         raise ParameterError(f"parameter file not found: {path} (shipped configurations: "
                              f"{', '.join(shipped_configs())})")
     try:  # TOML is UTF-8 by its specification, whatever the machine's locale
-        return path.read_bytes().decode("utf-8"), str(path)
+        # utf-8-sig: a byte-order mark (Windows editors write one) is dropped, not parsed
+        return path.read_bytes().decode("utf-8-sig"), str(path)
     except UnicodeDecodeError as exc:
         raise ParameterError(f"{path}: not UTF-8 text (TOML files are UTF-8): byte "
                              f"{exc.object[exc.start]:#04x} at offset {exc.start}") from None
@@ -625,6 +925,7 @@ def load_params(path: str | Path | None = None, overrides: dict[str, Any] | None
     p = params_from_dict(data)
     p = dataclasses.replace(p, provenance=tuple(sorted(status_comments(text).items())))
     p = apply_overrides(p, overrides) if overrides else p
+    check_plausibility(p)
     _advise(p, source)
     return p
 

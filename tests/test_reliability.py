@@ -540,11 +540,11 @@ def test_9_wind_air_inertia_is_on_the_configured_hull(capsys):
 def test_9_the_packages_warnings_are_one_line_on_stderr(capsys):
     """A ParameterWarning raised at the door reads like the CLI's errors: one line, prefixed
     with the command, no Python source line or category name."""
-    code, out, err = _cli(capsys, "trim", "--wind", "5", "--set", "simulation.semi_implicit_dt=5")
+    code, out, err = _cli(capsys, "trim", "--wind", "5", "--set", "simulation.semi_implicit_dt=0.08")
     assert code == 0 and out.startswith("Trim at U = 5 m/s")
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("aerostat-gym trim: warning: ")
-    assert "semi_implicit_dt = 5 s is longer than 0.05 s" in lines[0]
+    assert "semi_implicit_dt = 0.08 s is longer than 0.05 s" in lines[0]
     assert "ParameterWarning" not in err and ".py:" not in err
 
 

@@ -180,6 +180,85 @@ def _newton(model: Model, x: np.ndarray, tol: float, max_iter: int) -> tuple[np.
     return x, rel, max_iter
 
 
+def _continue_in_wind(model: Model, x: np.ndarray, u: float, wind_speed: float,
+                      max_step: float, tol: float) -> tuple[np.ndarray, float, int]:
+    """Newton continued in wind speed from the equilibrium ``x`` at ``u`` to ``wind_speed`` in
+    steps of at most ``max_step`` (halved on failure down to 1/64 of it): (x, residual,
+    iterations); TrimError where it stalls."""
+    rel, its, step = 0.0, 0, max_step
+    while True:
+        target = min(u + step, wind_speed) if wind_speed >= u else max(u - step, wind_speed)
+        model.set_wind(target)
+        xn, rel, it = _newton(model, x.copy(), tol, 40)
+        its += it
+        if rel <= tol:
+            x, u = xn, target
+            if u == wind_speed:
+                return x, rel, its
+            step = min(max_step, 2 * step)
+        else:
+            step /= 2
+            if step < max_step / 64:
+                raise TrimError(f"no equilibrium found at U = {target:.3f} m/s (continuing from "
+                                f"{u:.3f} m/s): relative residual {rel:.2e} > {tol:.0e}")
+
+
+#: Where the tether weighs more than this share of the net lift, a failed continuation in wind
+#: is retried by continuation in the tether's weight (:func:`_continue_in_tether_weight`). With
+#: a small margin of net lift over tether weight the lower tether carries almost no tension in
+#: light wind, so its lateral stiffness (tension / element length) is tiny beside its axial one
+#: (EA / element length) and Newton from the vertical zero-wind line stalls (the baseline with
+#: aerostat.mass = 587.9 kg: 72.5 N net lift, 69.9 N of tether, stalled at 0.078 m/s).
+LIFT_MARGIN_SHARE = 0.5
+#: Smallest continuation step in the tether's weight (share of the way to the real tether).
+_WEIGHT_STEP_MIN = 1.0 / 256
+
+
+def _continue_in_tether_weight(params: Params, wind_speed: float, max_step: float, tol: float,
+                               length: float | None, cause: TrimError) -> tuple[np.ndarray, float, int]:
+    """Trim at ``wind_speed`` with a lighter tether (weighing LIFT_MARGIN_SHARE of the net lift,
+    whose trim is well conditioned), then continue the tether's density back to its own value
+    at that wind speed, in adaptive steps. Raises TrimError naming the net-lift margin where
+    this fails too."""
+    d, rho = params.derived, params.tether.density
+    f = LIFT_MARGIN_SHARE * d.net_lift / d.tether_weight
+
+    def lighter(s: float) -> Params:  # s = 0: the light tether, s = 1: the real one
+        return params if s >= 1.0 else params.replace(**{"tether.density": rho * (f + (1 - f) * s)})
+
+    def fail(where: str) -> TrimError:
+        margin = d.net_lift - d.tether_weight
+        return TrimError(
+            f"{cause}; the net lift ({d.net_lift:.1f} N) exceeds the weight of the tether "
+            f"({d.tether_weight:.1f} N) by only {margin:.1f} N ({100 * margin / d.net_lift:.1f} % "
+            "of the net lift), so the lower tether is nearly slack in light wind and the trim "
+            f"is ill-conditioned; continuing from a lighter tether {where}. A lighter aerostat "
+            "(aerostat.mass), a larger one (aerostat.volume) or a shorter or lighter tether "
+            "(tether.length, tether.density, tether.diameter) widens the margin")
+
+    try:
+        start = Model(lighter(0.0), 0.0)
+        x, rel, its = _continue_in_wind(start, zero_wind_state(start.params, length), 0.0,
+                                        wind_speed, max_step, tol)
+    except TrimError:
+        raise fail("failed too") from cause
+    s, step = 0.0, 0.25
+    while s < 1.0:
+        sn = min(1.0, s + step)
+        model = Model(lighter(sn), 0.0)
+        model.set_wind(wind_speed)
+        xn, rel, it = _newton(model, x.copy(), tol, 40)
+        its += it
+        if rel <= tol:
+            x, s, step = xn, sn, min(0.5, 2 * step)
+        else:
+            step /= 2
+            if step < _WEIGHT_STEP_MIN:
+                raise fail(f"stalled at {100 * s:.1f} % of the way to this tether's weight "
+                           f"(relative residual {rel:.2e} > {tol:.0e})") from cause
+    return x, rel, its
+
+
 def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
                      guess: Equilibrium | None = None, max_step: float = 1.0,
                      tol: float = REL_TOL, length: float | None = None) -> Equilibrium:
@@ -196,7 +275,10 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
     Raises
     ------
     TrimError if Newton fails to reach ``tol`` even with continuation steps of 1/64 of
-    ``max_step``, or if the solution has a slack tether or the aerostat below the anchor.
+    ``max_step`` (and, without a guess and where the tether weighs more than
+    LIFT_MARGIN_SHARE of the net lift, also by continuation from a lighter tether at the
+    target wind speed; the message then gives the net-lift margin), or if the solution has a
+    slack tether or the aerostat below the anchor.
     """
     params = params or load_params()
     if not (is_finite_number(wind_speed) and 0 <= wind_speed <= MAX_WIND_SPEED):
@@ -208,24 +290,13 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
         x, u0 = zero_wind_state(params, length), 0.0
     else:
         x, u0 = guess.x.copy(), guess.wind_speed
-    rel, its = 0.0, 0
-    step = max_step
-    u = u0
-    while True:
-        target = min(u + step, wind_speed) if wind_speed >= u else max(u - step, wind_speed)
-        model.set_wind(target)
-        xn, rel, it = _newton(model, x.copy(), tol, 40)
-        its += it
-        if rel <= tol:
-            x, u = xn, target
-            if u == wind_speed:
-                break
-            step = min(max_step, 2 * step)
-        else:
-            step /= 2
-            if step < max_step / 64:
-                raise TrimError(f"no equilibrium found at U = {target:.3f} m/s (continuing from "
-                                f"{u:.3f} m/s): relative residual {rel:.2e} > {tol:.0e}")
+    try:
+        x, rel, its = _continue_in_wind(model, x, u0, wind_speed, max_step, tol)
+    except TrimError as exc:
+        d = params.derived
+        if guess is not None or d.tether_weight <= LIFT_MARGIN_SHARE * d.net_lift:
+            raise
+        x, rel, its = _continue_in_tether_weight(params, wind_speed, max_step, tol, length, exc)
     model.set_wind(wind_speed)
     summary = trim_summary(model, x, wind_speed)
     if summary["min_tension_N"] <= 0 or x[model.layout.cm_pos][2] <= 0:

@@ -1,0 +1,325 @@
+"""Implausible parameter files are refused at the loading door (audit of "bring your own
+aerostat" flows): unit slips, points outside the hull, broken symmetry, the compiled core's and
+the model's limits, a UTF-8 byte-order mark, and the trim of a small net-lift margin.
+
+Every refusal is a ParameterError (unit slips: its subclass ImplausibleParameterError) raised by
+load_params, from a file and from overrides alike, naming the field; unusual but possible values
+load with a ParameterWarning; real aerostats load without either."""
+
+from __future__ import annotations
+
+import math
+import re
+import warnings
+
+import pytest
+
+from aerostat_gym.analysis.trim import REL_TOL, TrimError, find_equilibrium
+from aerostat_gym.params import (
+    MAX_FIN_PANELS,
+    MAX_WIND_SPEED,
+    RK4_SAFETY_LIMIT,
+    ImplausibleParameterError,
+    ParameterError,
+    ParameterWarning,
+    dumps_toml,
+    load_params,
+    params_to_dict,
+    shipped_configs,
+)
+from aerostat_gym.scaling import scale_aerostat
+
+BASE = load_params()
+
+
+def _small7():
+    """The baseline scaled to a 7 m hull on a 50 m tether (the audit's small aerostat)."""
+    return scale_aerostat(BASE, (7.0 / 18.3) ** 3, 50.0, 5)
+
+
+def _set_in_toml(text: str, section: str, key: str, value: str) -> str:
+    """``key = value`` in ``[section]`` of a TOML text (the first occurrence after the header)."""
+    head = text.index(f"[{section}]\n")
+    m = re.compile(rf"^{re.escape(key)} = .*$", re.M).search(text, head)
+    assert m, (section, key)
+    return text[:m.start()] + f"{key} = {value}" + text[m.end():]
+
+
+def _load_quietly(*args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ParameterWarning)
+        return load_params(*args, **kwargs)
+
+
+# --- real aerostats load without errors or warnings ----------------------------------------------
+
+#: (volume factor, tether length [m], elements): hulls from 5 m to 70 m, tethers from 20 m to 5 km
+REAL = {
+    "5m_hull_20m_tether": ((5.0 / 18.3) ** 3, 20.0, 2),
+    "7m_hull_50m_tether": ((7.0 / 18.3) ** 3, 50.0, 5),
+    "0.011x_884m": (0.011, 884.0, 2),
+    "0.003x_1053m": (0.003, 1053.0, 29),
+    "35m_hull_1km": ((35.0 / 18.3) ** 3, 1000.0, 20),
+    "70m_hull_5km": ((70.0 / 18.3) ** 3, 5000.0, 50),
+}
+
+
+@pytest.mark.parametrize("name", shipped_configs())
+def test_shipped_configurations_load_without_warnings(name):
+    _load_quietly(name)  # a ParameterWarning is an error here
+
+
+@pytest.mark.parametrize("name", list(REAL))
+def test_real_aerostats_from_5_to_70_m_load_without_warnings(tmp_path, name):
+    p = scale_aerostat(BASE, *REAL[name])
+    f = tmp_path / "own.toml"
+    f.write_text(dumps_toml(p))
+    assert _load_quietly(f) == p
+
+
+@pytest.mark.parametrize("over", [
+    {"tether.youngs_modulus": 200e9, "tether.density": 7850.0},   # steel wire
+    {"tether.youngs_modulus": 70e9, "tether.density": 1440.0},    # aramid (Kevlar)
+    {"tether.youngs_modulus": 65e9, "tether.density": 1400.0},    # Vectran
+    {"tether.density": 4500.0},                                   # armoured conductor tether
+    {"hull.Cdc": 0.3}, {"aerostat.leash_z": -18.3},
+    {"simulation.rk4_safety": RK4_SAFETY_LIMIT},
+    {"wind.speed": MAX_WIND_SPEED}, {"tether.anchor_position": [0.0, 0.0, 120.0]},
+])
+def test_real_variants_load_without_warnings(over):
+    _load_quietly(overrides=over)
+
+
+def test_cruciform_fins_load_without_warnings():
+    """Four panels at +-45 and +-135 deg (an X tail) are two mirrored pairs."""
+    panels = [{"name": n, "roll_angle_deg": phi, "cp_position": [-5.715, y, z]}
+              for n, phi, y, z in (("ul", 45.0, 3.2937, 4.0117), ("ur", -45.0, -3.2937, 4.0117),
+                                   ("ll", 135.0, 3.2937, -2.5757), ("lr", -135.0, -3.2937, -2.5757))]
+    _load_quietly(overrides={"fins.panels": panels})
+
+
+# --- unit slips and impossible geometry: refused from a file and from overrides --------------------
+
+SMALL7 = _small7()
+X_NOSE_7 = SMALL7.aerostat.nose_position[0]
+
+#: (base, section, key, value, error class, texts the message must contain)
+REFUSED = [
+    (BASE, "tether", "youngs_modulus", 37.4e3, ImplausibleParameterError,
+     ("tether.youngs_modulus = 37400 Pa", "looks like MPa written as Pa")),
+    (BASE, "tether", "youngs_modulus", 37.4e15, ImplausibleParameterError,
+     ("tether.youngs_modulus", "stiffer than diamond")),
+    (BASE, "tether", "density", 0.975, ImplausibleParameterError,
+     ("tether.density = 0.975", "looks like g/cm^3 written as kg/m^3")),
+    (BASE, "aerostat", "diameter", 770.0, ImplausibleParameterError,
+     ("aerostat.diameter = 770", "looks like aerostat.diameter in cm")),
+    (BASE, "aerostat", "length", 1830.0, ImplausibleParameterError,
+     ("aerostat.length = 1830", "looks like aerostat.length in cm")),
+    (BASE, "simulation", "rk4_safety", 2.0, ImplausibleParameterError,
+     ("simulation.rk4_safety = 2", "1.02")),
+    (BASE, "simulation", "rk4_safety", 90.0, ImplausibleParameterError,
+     ("simulation.rk4_safety = 90", "percentage")),
+    # 2.4 x the baseline's advised 50 ms: past the measured failure edge (1.2-1.5 x)
+    (BASE, "simulation", "semi_implicit_dt", 0.12, ImplausibleParameterError,
+     ("simulation.semi_implicit_dt = 0.12 s", "2 x the 0.05 s advised", "<= 0.05")),
+    (SMALL7, "aerostat", "nose_position", [30.0, 0.0, 0.25], ImplausibleParameterError,
+     ("aerostat.nose_position x = 30", "behind the tail")),
+    (SMALL7, "aerostat", "nose_position", [-3.1, 0.0, 0.25], ImplausibleParameterError,
+     ("aerostat.nose_position x = -3.1", "ahead of the nose", "sign was flipped")),
+    (BASE, "aerostat", "cb_position", [9.5, 0.0, 0.718], ImplausibleParameterError,
+     ("aerostat.cb_position x = 9.5", "outside the hull")),
+    (BASE, "aerostat", "leash_z", -1155.0, ImplausibleParameterError,
+     ("aerostat.leash_z = -1155", "looks like cm written as m")),
+    (BASE, "aerostat", "leash_z", 11.55, ImplausibleParameterError,
+     ("aerostat.leash_z = 11.55", "must be < 0", "sign was flipped")),
+    (BASE, "aerostat", "leash_z", 0.0, ImplausibleParameterError, ("aerostat.leash_z = 0",)),
+    (BASE, "aerostat", "cb_position", [0.02, 1.0, 0.25], ImplausibleParameterError,
+     ("aerostat.cb_position", "y = 1 m", "symmetry")),
+    (BASE, "aerostat", "nose_position", [8.21, -0.5, 0.718], ImplausibleParameterError,
+     ("aerostat.nose_position", "y = -0.5 m", "symmetry")),
+    (BASE, "hull", "Cdc", 12.0, ImplausibleParameterError, ("hull.Cdc = 12",)),
+    (BASE, "wind", "speed", 500.0, ParameterError, ("wind.speed = 500 m/s", "100 m/s")),
+    (BASE, "tether", "anchor_position", [0.0, 0.0, -5.0], ParameterError,
+     ("tether.anchor_position", "below the ground")),
+]
+
+
+def _ids(case):
+    return f"{case[1]}.{case[2]}={case[3]!r}"
+
+
+@pytest.mark.parametrize("base, section, key, value, error, texts", REFUSED,
+                         ids=[_ids(c) for c in REFUSED])
+def test_refused_in_a_file(tmp_path, base, section, key, value, error, texts):
+    text = _set_in_toml(dumps_toml(base), section, key, repr(list(value) if isinstance(
+        value, list) else value))
+    f = tmp_path / "slip.toml"
+    f.write_text(text)
+    with pytest.raises(error) as err:
+        load_params(f)
+    for t in texts:
+        assert t in str(err.value)
+
+
+@pytest.mark.parametrize("base, section, key, value, error, texts", REFUSED,
+                         ids=[_ids(c) for c in REFUSED])
+def test_refused_as_an_override(tmp_path, base, section, key, value, error, texts):
+    f = tmp_path / "own.toml"
+    f.write_text(dumps_toml(base))
+    with pytest.raises(error) as err:
+        load_params(f, overrides={f"{section}.{key}": value})
+    for t in texts:
+        assert t in str(err.value)
+
+
+def test_fin_outside_the_hull_is_refused():
+    """A fin 100 m aft of the CM on a 7 m hull, and one ahead of the nose."""
+    panels = [dict(p) for p in params_to_dict(SMALL7)["fins"]["panels"]]
+    for x, where in ((-100.0, "fins.panels[0].cp_position x = -100"),
+                     (X_NOSE_7 + 1.0, "fins.panels[0].cp_position x = ")):
+        bad = [{**panels[0], "cp_position": [x, 0.0, 2.2]}] + panels[1:]
+        with pytest.raises(ImplausibleParameterError, match=re.escape(where)) as err:
+            load_params(overrides={**{k: v for k, v in _flat(SMALL7).items()},
+                                   "fins.panels": bad})
+        assert "aft of the tail" in str(err.value)
+
+
+def test_fin_slightly_aft_of_the_tail_loads():
+    """Fins may overhang the tail (by up to a quarter hull length)."""
+    a = SMALL7.aerostat
+    tail = a.nose_position[0] - a.length
+    panels = [{**p, "cp_position": [tail - 0.2 * a.length, *p["cp_position"][1:]]}
+              for p in params_to_dict(SMALL7)["fins"]["panels"]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ParameterWarning)
+        load_params(overrides={**_flat(SMALL7), "fins.panels": panels})
+
+
+def test_fin_far_off_the_axis_is_refused():
+    panels = [dict(p) for p in params_to_dict(BASE)["fins"]["panels"]]
+    panels[0]["cp_position"] = [-5.715, 0.0, 53.76]
+    with pytest.raises(ImplausibleParameterError, match=r"fins\.panels\[0\]\.cp_position"):
+        load_params(overrides={"fins.panels": panels})
+
+
+def test_swapped_length_and_diameter_are_refused():
+    with pytest.raises(ImplausibleParameterError) as err:
+        load_params(overrides={"aerostat.length": 7.7, "aerostat.diameter": 18.3,
+                               "hull.l_h": 5.0})
+    assert "aerostat.length / aerostat.diameter" in str(err.value)
+    assert "swapped" in str(err.value)
+
+
+def _flat(p) -> dict:
+    """Every input of ``p`` as dotted overrides (to load another aerostat through the door)."""
+    return {f"{sec}.{k}": v for sec, table in params_to_dict(p).items() for k, v in table.items()}
+
+
+# --- more than MAX_FIN_PANELS fin panels ----------------------------------------------------------
+
+def test_eight_fin_panels_are_a_parameter_error_at_load(tmp_path):
+    panels = params_to_dict(BASE)["fins"]["panels"]
+    eight = [{**panels[i % 3], "name": f"f{i}"} for i in range(8)]
+    with pytest.raises(ParameterError, match=r"fins\.panels has 8 panels; at most 6") as err:
+        load_params(overrides={"fins.panels": eight})
+    assert not isinstance(err.value, ImplausibleParameterError)
+    with pytest.raises(ParameterError, match=r"fins\.panels"):  # and on every replace
+        BASE.replace(**{"fins.panels": eight})
+
+
+def test_limits_match_the_compiled_core():
+    """The limits mirrored in params (which sits below the physics layer) equal the core's."""
+    from aerostat_gym.physics import integrators
+    from aerostat_gym.physics.packing import MAX_FINS
+    from aerostat_gym.physics.wind import MAX_WIND_SPEED as CORE_MAX_WIND
+
+    assert MAX_FIN_PANELS == MAX_FINS
+    assert MAX_WIND_SPEED == CORE_MAX_WIND
+    assert f"{RK4_SAFETY_LIMIT:g} times this bound" in integrators.rk4_step.__doc__
+
+
+# --- unusual but possible: a ParameterWarning naming the field ---------------------------------
+
+@pytest.mark.parametrize("over, field", [
+    ({"hull.Cdc": 2.0}, "hull.Cdc = 2"),
+    ({"tether.density": 300.0}, "tether.density = 300"),
+    ({"tether.density": 12000.0}, "tether.density = 12000"),
+    ({"tether.youngs_modulus": 3.0e9}, "tether.youngs_modulus = 3e+09"),  # nylon-like: 42 %
+    ({"aerostat.volume": 300.0, "aerostat.mass": 120.0}, "aerostat.volume = 300"),
+])
+def test_unusual_values_warn(over, field):
+    with pytest.warns(ParameterWarning, match=re.escape(field)):
+        load_params(overrides=over)
+
+
+def test_fins_without_a_mirror_panel_warn():
+    panels = params_to_dict(BASE)["fins"]["panels"][:2]  # upper and port, no starboard
+    with pytest.warns(ParameterWarning, match=r"fins\.panels\[1\] \('port'.*no mirror panel"):
+        load_params(overrides={"fins.panels": panels})
+
+
+def test_studies_may_still_move_values_past_the_door():
+    """Params.replace checks the limits of the core but not plausibility: a weightless tether
+    or RK4 past its stability bound stay available to tests of those regimes."""
+    assert BASE.replace(**{"simulation.rk4_safety": 1.4}).simulation.rk4_safety == 1.4
+    assert BASE.replace(**{"tether.density": 1e-3}).tether.density == 1e-3
+    with pytest.raises(ImplausibleParameterError, match=r"simulation\.rk4_safety"):
+        load_params(overrides={"simulation.rk4_safety": 1.4})
+
+
+# --- a UTF-8 byte-order mark -------------------------------------------------------------------
+
+def test_a_utf8_bom_is_accepted(tmp_path):
+    f = tmp_path / "bom.toml"
+    f.write_bytes(b"\xef\xbb\xbf" + dumps_toml(BASE).encode("utf-8"))
+    assert _load_quietly(f) == BASE
+
+
+def test_a_bom_in_the_middle_is_still_invalid_toml(tmp_path):
+    f = tmp_path / "bom2.toml"
+    text = dumps_toml(BASE)
+    f.write_bytes(text.encode("utf-8").replace(b"[tether]", b"\xef\xbb\xbf[tether]", 1))
+    with pytest.raises(ParameterError, match="invalid TOML"):
+        load_params(f)
+
+
+# --- trim with a small net-lift margin -----------------------------------------------------------
+
+LOW_MARGIN = {"aerostat.mass": 587.9}  # net lift 72.5 N, tether weight 69.9 N
+
+
+def test_low_margin_trims_at_10_m_s():
+    """The audit's case: the continuation in wind from the vertical zero-wind line stalls at
+    0.078 m/s; the trim is reached from a lighter tether instead, and is the equilibrium that
+    a continuation in aerostat mass (from 586 kg, 91 N net lift) finds (5.6e-11 m apart)."""
+    p = load_params(overrides=LOW_MARGIN)
+    d = p.derived
+    assert d.net_lift == pytest.approx(72.5, abs=0.05)
+    assert d.tether_weight == pytest.approx(69.9, abs=0.05)
+    eq = find_equilibrium(p, 10.0)
+    assert eq.residual <= REL_TOL
+    near = find_equilibrium(load_params(overrides={"aerostat.mass": 586.0}), 10.0)
+    ref = find_equilibrium(p, 10.0, guess=near)
+    assert ref.residual <= REL_TOL
+    assert max(abs(eq.x - ref.x)) < 1e-6
+    s = eq.summary
+    assert s["winch_tension_N"] == pytest.approx(ref.summary["winch_tension_N"], rel=1e-6)
+    assert s["min_tension_N"] > 0 and s["aerostat_position_m"][2] > 0
+
+
+def test_low_margin_failure_names_the_margin():
+    """Where the trim cannot be reached (here: an unreachable tolerance), the error gives the
+    net lift, the tether's weight and the margin between them."""
+    p = load_params(overrides=LOW_MARGIN)
+    with pytest.raises(TrimError) as err:
+        find_equilibrium(p, 10.0, tol=1e-30)
+    msg = str(err.value)
+    assert "net lift (72.5 N)" in msg and "tether (69.9 N)" in msg and "by only 2.6 N" in msg
+    assert "aerostat.mass" in msg
+
+
+def test_a_comfortable_margin_keeps_the_plain_message():
+    with pytest.raises(TrimError) as err:
+        find_equilibrium(BASE, 10.0, tol=1e-30)
+    assert "net lift" not in str(err.value)
+    assert math.isfinite(BASE.derived.net_lift)
