@@ -10,6 +10,7 @@ import warnings
 
 import numba
 import numpy as np
+from gymnasium.error import ClosedEnvironmentError, ResetNeeded
 
 from ..analysis.trim import TrimError
 from ..checks import is_whole
@@ -109,6 +110,7 @@ class EnvBatch:
         self.obs_dim = spaces.N_OBS + (1 + S if self.full_size else 0)
         self.obs_low, self.obs_high = spaces.bounds(self.full_size, params)
         self.trims = trim_table(task)
+        self.closed = False  # set by release(): the bank is gone
         self.bank = self._bank()
         self.cfg = self._config(params)
         # per-slot arrays, one row per environment
@@ -145,8 +147,34 @@ class EnvBatch:
         return unit_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
 
     def release(self) -> None:
-        """Drop this batch's reference to the turbulence bank (freed with its last user)."""
+        """Drop this batch's reference to the turbulence bank (freed with its last user): the
+        batch is closed, and its environments refuse every call but close (see
+        :meth:`check_open`)."""
         self.bank = NO_BANK
+        self.closed = True
+
+    def check_open(self, call: str) -> None:
+        """Refuse ``call`` on a closed batch: without its turbulence bank it would run in calm
+        air while its infos still report the turbulence."""
+        if self.closed:
+            raise ClosedEnvironmentError(
+                f"{call} on a closed environment: close() released its turbulence fields; "
+                "make a new environment to go on")
+
+    def check_started(self, call: str) -> None:
+        """Refuse ``call`` (step, render) on an open batch with a slot that has no episode: its
+        all-zero state would only read as a numerical failure."""
+        self.check_open(call)
+        idle = [i for i, ep in enumerate(self.episodes) if ep is None]
+        if idle:
+            which = "" if self.num_envs == 1 else f" (environment(s) {idle[:4]} never reset)"
+            raise ResetNeeded(f"{call} before reset(){which}: call reset() to start an "
+                              "episode first")
+
+    @property
+    def started(self) -> bool:
+        """Whether the batch is open and every slot has an episode (a step may run)."""
+        return not self.closed and all(ep is not None for ep in self.episodes)
 
     def __getstate__(self):  # the trims and the bank are rebuilt (or found in the cache)
         d = dict(self.__dict__)
@@ -155,8 +183,10 @@ class EnvBatch:
 
     def __setstate__(self, d):
         self.__dict__.update(d)
+        self.__dict__.setdefault("closed", False)  # pickled before the flag existed
         self.trims = TrimTable(self.params, *self.task.resolved["wind_speed"])
-        self.bank = self._bank()  # found in the cache while another holder lives
+        # found in the cache while another holder lives; a closed batch stays closed
+        self.bank = NO_BANK if self.closed else self._bank()
 
     def _config(self, params) -> np.ndarray:
         t, w = self.task, params.winch
@@ -229,6 +259,7 @@ class EnvBatch:
     def set_slot(self, i: int, saved: dict) -> None:
         """Restore slot i from :meth:`get_slot`'s output: stepping on from it reproduces the
         original run bit for bit (the work arrays are recomputed by every step)."""
+        self.check_open("set_state()")
         missing = sorted(set(self.SLOT_ARRAYS) - set(saved))
         if missing:
             raise ValueError(f"simulator state lacks {missing}")
@@ -301,7 +332,8 @@ class EnvBatch:
 
 
 def held_wind_top(params: Params, lo: float, hi: float) -> float:
-    """The highest wind on the 0.1 m/s grid of [lo, hi] whose trim the configured tether holds
+    """The highest wind of the trim table of [lo, hi] (its 0.1 m/s grid points and its ends)
+    whose trim the configured tether holds
     (largest tension below ``tether.strength``, :func:`~aerostat_gym.analysis.trim.
     largest_trim_tension`; it grows with the wind), ``hi`` where it holds them all and ``lo``
     where it holds none (:func:`trim_table` then names the tension)."""

@@ -66,10 +66,10 @@ def _range(name, value, lo_min=0.0, hi_max=math.inf):
     """A (low, high) range in [lo_min, hi_max]; a single number is the fixed value (value,
     value)."""
     pair = (value, value) if is_number(value) else value
-    try:
-        lo, hi = (float(v) for v in pair)
-    except (TypeError, ValueError):
-        raise TaskError(f"{name} must be a number or a (low, high) pair, got {value!r}") from None
+    if not (isinstance(pair, (tuple, list, np.ndarray)) and len(pair) == 2
+            and all(is_number(v) for v in pair)):  # "12" is no pair; True is no number
+        raise TaskError(f"{name} must be a number or a (low, high) pair, got {value!r}")
+    lo, hi = (float(v) for v in pair)
     if not (math.isfinite(lo) and math.isfinite(hi) and lo_min <= lo <= hi <= hi_max):
         top = "" if hi_max == math.inf else f" <= {hi_max:g}"
         raise TaskError(f"{name} must satisfy {lo_min} <= low <= high{top} (finite), got "
@@ -284,11 +284,23 @@ def get_parameter(params: Params, key: str):
     return getattr(getattr(params, sec), name)
 
 
+#: [rad] largest pitch kick: the Z-Y-X Euler kinematics of the state are singular with the
+#: nose vertical (theta = +-pi/2), so a larger kick is a flip through the vertical, not a pitch
+MAX_PITCH_KICK = math.pi / 2
+#: [s] longest gust: a 1 - cos change slower than an hour is a change of the mean wind (whose
+#: averaging periods run from 10 min to 1 h), not a gust
+MAX_GUST_DURATION = 3600.0
+#: [s] latest gust onset: a day is beyond any episode (the registered ones last 120 s); the bound
+#: keeps the gust front's start position U_a * onset finite
+MAX_GUST_ONSET = 86400.0
+
+
 def perturbation(spec, tether_length: float | None = None) -> dict:
     """A validated perturbation dict from a preset name or a (partial) dict. A preset's swing
     and lateral displacement are scaled to a tether of ``tether_length`` [m]
     (:func:`displacement_scale`; None: as stated, for the reference tether); a dict's are
-    taken as given, in metres."""
+    taken as given, in metres. Every field is bounded (:func:`_check_displacements`,
+    :func:`_check_gust`): a TaskError names the field, its value and the bound."""
     if isinstance(spec, str):
         if spec not in PERTURBATIONS:
             raise TaskError(f"unknown perturbation {spec!r}; choose one of {list(PERTURBATIONS)}"
@@ -303,16 +315,46 @@ def perturbation(spec, tether_length: float | None = None) -> dict:
     if unknown:
         raise TaskError(f"unknown perturbation key(s) {unknown}; known: {sorted(out)}")
     out.update(spec)
-    for k in ("swing", "lateral", "pitch"):
-        ok = isinstance(out[k], (int, float)) and math.isfinite(out[k])
-        if not ok or (out[k] < 0 and not out["fixed"]):
-            raise TaskError(f"perturbation {k} must be a finite number (>= 0 unless fixed), "
-                            f"got {out[k]!r}")
     if not isinstance(out["fixed"], bool):
         raise TaskError(f"perturbation fixed must be True or False, got {out['fixed']!r}")
-    if not 0 <= out["gust_probability"] <= 1:
-        raise TaskError(f"perturbation gust_probability must be in [0, 1], got "
-                        f"{out['gust_probability']!r}")
-    for k in GUST_DEFAULTS:
-        out[k] = _range(f"perturbation {k}", out[k])
+    _check_displacements(out, tether_length)
+    _check_gust(out)
     return out
+
+
+def _check_displacements(out: dict, tether_length: float | None) -> None:
+    """swing and lateral [m] are arcs of a rigid rotation about the winch, at most the tether's
+    length (about a radian: beyond it the aerostat is swung into the ground; unchecked before
+    the parameters, and so the length, are known); pitch [rad] at most
+    :data:`MAX_PITCH_KICK`. Amplitudes are >= 0 unless ``fixed`` (then signed)."""
+    bounds = {"swing": tether_length, "lateral": tether_length, "pitch": MAX_PITCH_KICK}
+    units = {"swing": "m", "lateral": "m", "pitch": "rad"}
+    for k, top in bounds.items():
+        v = out[k]
+        if not is_finite_number(v) or (v < 0 and not out["fixed"]):
+            raise TaskError(f"perturbation {k} must be a finite number (>= 0 unless fixed), "
+                            f"got {v!r}")
+        if top is not None and abs(v) > top:
+            why = ("the tether length" if k != "pitch" else
+                   "pi/2 (the nose vertical, where the Euler kinematics are singular)")
+            raise TaskError(f"perturbation {k} = {v!r} {units[k]} exceeds {why}: |{k}| <= "
+                            f"{top:g} {units[k]}")
+
+
+def _check_gust(out: dict) -> None:
+    """gust_probability in [0, 1]; gust_amplitude [m/s] in [0, MAX_WIND_SPEED] (the gust adds
+    to the mean wind, whose incompressible aerodynamics end there); gust_duration [s] in
+    (0, MAX_GUST_DURATION] (a gust of no length has no shape); gust_onset [s] in
+    [0, MAX_GUST_ONSET]."""
+    p = out["gust_probability"]
+    if not (is_finite_number(p) and 0 <= p <= 1):
+        raise TaskError(f"perturbation gust_probability must be a number in [0, 1], got {p!r}")
+    out["gust_amplitude"] = _range("perturbation gust_amplitude [m/s]", out["gust_amplitude"],
+                                   hi_max=MAX_WIND_SPEED)
+    lo, hi = out["gust_duration"] = _range("perturbation gust_duration [s]",
+                                           out["gust_duration"], hi_max=MAX_GUST_DURATION)
+    if lo <= 0:
+        raise TaskError(f"perturbation gust_duration must be > 0 s (a gust of no length has no "
+                        f"shape), got {out['gust_duration']!r}")
+    out["gust_onset"] = _range("perturbation gust_onset [s]", out["gust_onset"],
+                               hi_max=MAX_GUST_ONSET)

@@ -106,8 +106,9 @@ class TetheredAerostatEnv(gym.Env):
 
     ## Starting State
 
-    The exact trim (equilibrium) for a mean wind speed drawn uniformly on the 0.1 m/s grid of
-    ``wind_speed`` (default 3 to 15 m/s), then perturbed (``perturbation``, default
+    The exact trim (equilibrium) for a mean wind speed drawn uniformly among the points of the
+    0.1 m/s grid inside ``wind_speed`` (default 3 to 15 m/s; a single number is taken exactly,
+    on the grid or off it), then perturbed (``perturbation``, default
     ``"mixed"``): aerostat and tether swung rigidly about the winch by up to 10 m along the
     wind and 5 m across it (no element stretched), the aerostat pitched about its confluence
     point by up to 0.05 rad, and with probability 0.5 a 1 - cos gust along the wind (1-4 m/s,
@@ -116,7 +117,9 @@ class TetheredAerostatEnv(gym.Env):
     is a frozen coherent field from a bank of unit-variance fields generated once per process
     from ``wind_bank_seed``; each episode reads a random bank field from a random along-wind
     offset, scaled to that episode's mean wind.
-    ``reset(options={"wind_speed": U, "perturbation": ...})`` fixes them for one episode.
+    ``reset(options={"wind_speed": U, "perturbation": ...})`` fixes them for one episode (U
+    exactly, anywhere in the task's range: off the grid the trim is computed at the reset, a
+    few ms).
 
     ## Episode End
 
@@ -137,8 +140,10 @@ class TetheredAerostatEnv(gym.Env):
 
     ``gym.make("TetheredAerostat-v0", **kwargs)`` with:
 
-    - ``wind_speed=(3.0, 15.0)``: range of the episode's mean wind speed [m/s]; a single number
-      fixes it (``wind_speed=10.0`` is ``(10.0, 10.0)``; the same holds for the gust ranges).
+    - ``wind_speed=(3.0, 15.0)``: range of the episode's mean wind speed [m/s], drawn among the
+      0.1 m/s grid points inside it (a range holding none, such as ``(3.01, 3.04)``, is a
+      ``TaskError``); a single number fixes it exactly (``wind_speed=10.05`` is
+      ``(10.05, 10.05)``; the same holds for the gust ranges).
     - ``turbulence="moderate"``: intensity class ("none", "light", "moderate", "severe":
       sigma follows each episode's mean wind, :mod:`aerostat_gym.wind.presets`), "config" (the
       parameter file's ``wind.turbulence`` and ``wind.turbulence_model``), or a dict of
@@ -256,9 +261,28 @@ class TetheredAerostatEnv(gym.Env):
       start whose first draw is a body is bit-identical (19 of the 20 return seeds of
       ``TetheredAerostatRealistic-v0``; seed 1001 draws again); a stream of unseeded resets
       differs from its first redraw on. Unrandomised tasks are bit-identical.
+    - v0 (aerostat-gym 0.7.13; the registered tasks, their seeded episodes and every stored
+      evaluation unchanged): the episode's wind speed is the one asked for: a single
+      ``wind_speed`` or a reset option off the 0.1 m/s grid is trimmed exactly (was moved to
+      the grid: 10.05 gave 10.0 at make and 10.1 as a reset option, 0.05 gave 0.0), a reset
+      option outside the range is refused (was accepted within 0.05 m/s of its ends), a range
+      draws among the grid points inside it (was rounded: (3.01, 3.04) drew 3.0) and a range
+      with none is a ``TaskError``; ``step()`` before ``reset()`` raises
+      ``gymnasium.error.ResetNeeded`` (was a ``nonfinite_state`` failure), ``render()`` before
+      it too (an AttributeError), and every call but ``close()`` after ``close()`` raises
+      ``gymnasium.error.ClosedEnvironmentError`` (ran on in calm air); the perturbation's
+      fields are bounded (swing and lateral by the tether length, pitch by pi/2, gust
+      amplitude by 100 m/s, duration in (0, 3600] s, onset by 86400 s) and a turbulence bank
+      above 4 GiB (``aerostat_gym.wind.synthesis.MAX_FIELD_BYTES``) is a ``TaskError`` at make
+      (was a NumPy MemoryError); the native vector env's infos are ``SyncVectorEnv``'s (plain
+      reset keys, ``final_info``, ``time``; no ``truncation`` reason at a time limit). With
+      the winch off the origin (``tether.anchor_position``) the start's swing pivots on the
+      winch (it pivoted on the origin, which stretched the tether and broke it on the first
+      step); with the winch at the origin, as in every registered task, starts are unchanged.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
+    _ready = False  # set by reset() and set_state(), cleared by close()
 
     def __init__(self, render_mode: str | None = None, **kwargs):
         if render_mode is not None and render_mode not in RENDER_MODES:
@@ -271,19 +295,24 @@ class TetheredAerostatEnv(gym.Env):
         self.observation_space = gym.spaces.Box(b.obs_low, b.obs_high, dtype=np.float32)
         self.metadata = {**self.metadata, "render_fps": round(1.0 / self.task.control_step)}
         self._renderer = None
+        self._ready = False  # an episode runs and the env is open: step() may go on
 
     # --- Gymnasium API ---------------------------------------------------------------------
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        self._batch.check_open("reset()")
         super().reset(seed=seed)
         info = self._batch.reset_one(0, self.np_random, options)
         self._batch.add_noise(0, self.np_random)
+        self._ready = True
         if self.render_mode == "human":
             self.render()
         return self._batch.obs[0].copy(), info
 
     def step(self, action):
         b = self._batch
+        if not self._ready:  # one flag per step; the reason is worked out only when it fails
+            b.check_started("step()")
         clipped = b.set_actions(action)
         b.step()
         b.add_noise(0, self.np_random)
@@ -316,6 +345,7 @@ class TetheredAerostatEnv(gym.Env):
             gym.logger.warn("render() called without a render_mode; pass render_mode="
                             "'rgb_array' or 'human' to gym.make")
             return None
+        self._batch.check_started("render()")
         if self._renderer is None:
             self._renderer = Renderer(self._batch.params, self.render_mode,
                                       fps=self.metadata["render_fps"])
@@ -326,6 +356,7 @@ class TetheredAerostatEnv(gym.Env):
             self._renderer.close()
             self._renderer = None
         self._batch.release()
+        self._ready = False
 
     # --- helpers ---------------------------------------------------------------------------
 
@@ -349,6 +380,7 @@ class TetheredAerostatEnv(gym.Env):
             raise ValueError("set_state expects a dict from get_state()")
         self._batch.set_slot(0, saved)
         self.np_random.bit_generator.state = saved["np_random"]
+        self._ready = True
         return self._batch.obs[0].copy()
 
     @property

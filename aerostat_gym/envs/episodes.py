@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis.trim import Equilibrium, TrimError, find_equilibrium, largest_trim_tension
+from ..checks import is_number
 from ..params import InertiaError, ParameterError, Params, apply_overrides, dumps_toml
 from ..physics.core import euler_angles, rotation_matrix
 from ..physics.packing import pack_params
@@ -28,10 +29,17 @@ from ..physics.wind import (
 )
 from ..sim import Model
 from ..wind.presets import TurbulenceConfig
-from ..wind.synthesis import fft_length, veers_field
+from ..wind.synthesis import check_field_size, fft_length, veers_field
 from .config import TaskConfig, TaskError, get_parameter, perturbation
 
-WIND_GRID = 0.1  # [m/s] episode wind speeds are drawn on this grid, where the trims are exact
+#: [m/s] step of the trim table: the trims are computed once per parameter set by continuation
+#: in wind speed on this grid (0.7 s for 3-15 m/s on the baseline) and episodes draw their speed
+#: among its points, which is what makes a reset cheap; a fixed speed off the grid (the task's
+#: single ``wind_speed`` or a reset option) is trimmed exactly from its nearest table trim (a
+#: few ms per reset)
+WIND_GRID = 0.1
+#: [m/s] a speed this close to a grid point is that grid point (binary fractions of 0.1)
+GRID_TOL = 1e-9
 FIELD_DXI = 1.0  # [m] along-wind step of the turbulence bank (0.07-0.33 s at 15-3 m/s)
 #: [s] the bank's fields are sized to serve this long a stretch at the task's top speed, twice
 #: over (random start offsets); they are periodic and read modulo their length, so episodes of
@@ -56,14 +64,34 @@ _TRIMS: dict = {}
 
 
 class TrimTable:
-    """Exact trims on the wind-speed grid of the task, computed once per parameter set by
-    continuation in wind speed and shared by every environment in the process."""
+    """Exact trims of the task's wind range, computed once per parameter set by continuation in
+    wind speed and shared by every environment in the process.
+
+    ``speeds`` holds the points of the :data:`WIND_GRID` inside [lo, hi] and, where an end of
+    the range is off the grid, that end itself (so the range's largest trim tension is
+    checked); episodes draw their speed uniformly among the grid points (``draws``, indices
+    into ``speeds``), or take ``lo`` when the range is a single speed. A range of two speeds
+    with no grid point between them is a :class:`TaskError` naming the grid.
+    """
 
     def __init__(self, params: Params, lo: float, hi: float):
         self.params = params
-        self.speeds = np.round(np.arange(round(lo / WIND_GRID), round(hi / WIND_GRID) + 1)
-                               * WIND_GRID, 10)
-        key = (dumps_toml(params), float(self.speeds[0]), float(self.speeds[-1]))
+        grid = _grid_points(lo, hi)
+        if lo == hi:
+            self.speeds = grid if grid.size else np.array([float(lo)])
+        elif not grid.size:
+            raise TaskError(f"wind_speed ({lo:g}, {hi:g}) holds no point of the "
+                            f"{WIND_GRID:g} m/s grid that episode speeds are drawn on (nearest: "
+                            f"{_grid_speed(np.floor(lo / WIND_GRID)):g} and "
+                            f"{_grid_speed(np.ceil(hi / WIND_GRID)):g} m/s); widen the range "
+                            f"to hold one, or pass a single number to fix the speed exactly")
+        else:
+            ends = ([float(lo)] if grid[0] - lo > GRID_TOL else [],
+                    [float(hi)] if hi - grid[-1] > GRID_TOL else [])
+            self.speeds = np.concatenate([ends[0], grid, ends[1]])
+        on_grid = np.isin(self.speeds, grid)
+        self.draws = np.flatnonzero(on_grid) if on_grid.any() else np.array([0])
+        key = (dumps_toml(params), tuple(self.speeds.tolist()))
         if key not in _TRIMS:
             while len(_TRIMS) >= MAX_CACHED_TRIMS:
                 del _TRIMS[next(iter(_TRIMS))]  # dicts keep insertion order: the oldest
@@ -73,6 +101,32 @@ class TrimTable:
 
     def equilibrium(self, k: int) -> Equilibrium:
         return Equilibrium(self.states[k].copy(), float(self.speeds[k]), self.params, 0.0, 0, {})
+
+    def index(self, speed: float) -> int | None:
+        """Index of ``speed`` in the table (within :data:`GRID_TOL`), or None."""
+        k = self.nearest(speed)
+        return k if abs(self.speeds[k] - speed) <= GRID_TOL else None
+
+    def nearest(self, speed: float) -> int:
+        """Index of the table speed nearest ``speed`` (the continuation's start)."""
+        return int(np.argmin(np.abs(self.speeds - speed)))
+
+    def contains(self, speed: float) -> bool:
+        """Whether ``speed`` lies in the table's range (NaN does not)."""
+        return self.speeds[0] - GRID_TOL <= speed <= self.speeds[-1] + GRID_TOL
+
+
+def _grid_speed(i) -> float:
+    """Grid point i [m/s], rounded so that 3.0 is 3.0 (not 30 * 0.1 = 3.0000000000000004)."""
+    return float(np.round(i * WIND_GRID, 10))
+
+
+def _grid_points(lo: float, hi: float) -> np.ndarray:
+    """The :data:`WIND_GRID` points in [lo, hi] (an end within :data:`GRID_TOL` of a point
+    counts as that point)."""
+    first = int(np.ceil(lo / WIND_GRID - GRID_TOL / WIND_GRID))
+    last = int(np.floor(hi / WIND_GRID + GRID_TOL / WIND_GRID))
+    return np.round(np.arange(first, last + 1) * WIND_GRID, 10)
 
 
 def _build_trims(params: Params, speeds: np.ndarray):
@@ -106,7 +160,9 @@ def turbulence_bank(cfg: TurbulenceConfig, size: int, seed: int, length: float) 
     inverse-FFT synthesis makes each field exactly periodic with its length n_xi FIELD_DXI,
     which is why the environments read it modulo that length (a seamless wrap).
     """
-    n = fft_length(length / FIELD_DXI + 1.0)
+    samples = length / FIELD_DXI + 1.0
+    check_bank_size(cfg, size, samples)
+    n = fft_length(samples)
     key = (cfg, size, seed, n)
     bank = _BANKS.get(key)
     if bank is None:
@@ -117,6 +173,19 @@ def turbulence_bank(cfg: TurbulenceConfig, size: int, seed: int, length: float) 
             return bank
         _BANKS[key] = bank
     return bank
+
+
+def check_bank_size(cfg: TurbulenceConfig, size: int, samples: float) -> None:
+    """A bank above :data:`~aerostat_gym.wind.synthesis.MAX_FIELD_BYTES` is a TaskError naming
+    the grid's settings and the memory it would take, raised before anything is allocated."""
+    detail = (f" along the wind (every {FIELD_DXI:g} m over twice downwind_extent = "
+              f"{cfg.downwind_extent:g} m + upwind_extent = {cfg.upwind_extent:g} m + "
+              f"{FIELD_PERIOD_HORIZON:g} s at the top wind)")
+    try:
+        check_field_size(cfg, samples, size, detail)
+    except ValueError as exc:
+        raise TaskError(f"turbulence bank (wind_bank_size = {size}): {exc}; raise dz, lower "
+                        "the extents or wind_bank_size") from None
 
 
 def cached_bank_bytes() -> int:
@@ -161,8 +230,8 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
                    options: dict | None = None) -> Episode:
     """Draw one episode start: wind speed, parameters, trim, turbulence offset, perturbation.
 
-    ``options`` (from ``reset(options=...)``) may fix ``wind_speed`` (snapped to the 0.1 m/s
-    grid) and ``perturbation`` (a preset name or dict) for this episode.
+    ``options`` (from ``reset(options=...)``) may fix ``wind_speed`` (exactly, inside the
+    task's range) and ``perturbation`` (a preset name or dict) for this episode.
     """
     opts = reset_options(options)
     unknown = sorted(set(opts) - {"wind_speed", "perturbation"})
@@ -170,10 +239,10 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
         raise TaskError(f"unknown reset option(s) {unknown}; known: ['perturbation', 'wind_speed']")
     pert = (perturbation(opts["perturbation"], trims.params.tether.length)
             if "perturbation" in opts else task.resolved["perturbation"])
-    k = _speed_index(trims, opts.get("wind_speed"), rng)
-    U = float(trims.speeds[k])
-    params, x_trim = _parameters(task, trims, k, rng)
-    tension = (trims.tensions[k] if params is trims.params
+    U = _episode_speed(trims, opts.get("wind_speed"), rng)
+    params, x_trim = _parameters(task, trims, U, rng)
+    k = trims.index(U)
+    tension = (trims.tensions[k] if params is trims.params and k is not None
                else Model(params, U).end_tensions(x_trim)[1])
     cfg = task.resolved["turbulence"]
     wp = mean_wind(params.wind, U)
@@ -193,22 +262,31 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
                    info)
 
 
-def _speed_index(trims: TrimTable, fixed, rng) -> int:
+def _episode_speed(trims: TrimTable, fixed, rng) -> float:
+    """The episode's mean wind speed [m/s]: a grid point of the table drawn uniformly, or the
+    reset option ``fixed``, exactly, where it lies in the task's range (no draw then: a
+    seed's episode at a fixed speed is the one it always was)."""
     if fixed is None:
-        return int(rng.integers(len(trims.speeds)))
-    try:
-        speed = float(fixed)
-    except (TypeError, ValueError):
-        raise TaskError(f"reset option wind_speed must be a number [m/s], got {fixed!r}") from None
-    k = int(np.argmin(np.abs(trims.speeds - speed)))
-    if not abs(trims.speeds[k] - speed) <= WIND_GRID / 2 + 1e-9:  # NaN fails too
+        return float(trims.speeds[trims.draws[int(rng.integers(len(trims.draws)))]])
+    if not is_number(fixed):
+        raise TaskError(f"reset option wind_speed must be a number [m/s], got {fixed!r}")
+    if not trims.contains(fixed):  # NaN and infinities too
         raise TaskError(f"reset option wind_speed={fixed!r} is outside the task's range "
                         f"[{trims.speeds[0]}, {trims.speeds[-1]}] m/s")
-    return k
+    k = trims.index(fixed)
+    return float(fixed) if k is None else float(trims.speeds[k])
 
 
-def _parameters(task: TaskConfig, trims: TrimTable, k: int, rng) -> tuple[Params, np.ndarray]:
-    """Nominal parameters and trim, or randomised ones re-trimmed from the nominal trim.
+def _continued_trim(params: Params, trims: TrimTable, U: float) -> np.ndarray:
+    """Trim state of ``params`` at wind speed U, continued from the table's nearest trim (a few
+    ms off the grid, where the nominal trim is; TrimError where none is found)."""
+    return find_equilibrium(params, U, guess=trims.equilibrium(trims.nearest(U)),
+                            max_step=WIND_GRID).x
+
+
+def _parameters(task: TaskConfig, trims: TrimTable, U: float, rng) -> tuple[Params, np.ndarray]:
+    """Nominal parameters and trim (the table's, or trimmed exactly at an off-grid U), or
+    randomised ones re-trimmed from the nominal trim.
 
     The randomised parameters are drawn independently and uniformly in their ranges; a draw
     whose moments of inertia no body has (a triangle inequality broken, about 10 % of the
@@ -217,7 +295,13 @@ def _parameters(task: TaskConfig, trims: TrimTable, k: int, rng) -> tuple[Params
     times (:data:`MAX_REDRAWS`)."""
     spec = task.resolved["randomize"]
     if not spec:
-        return trims.params, trims.states[k].copy()
+        k = trims.index(U)
+        if k is not None:
+            return trims.params, trims.states[k].copy()
+        try:  # between two table trims of the same parameters: a failure is not expected
+            return trims.params, _continued_trim(trims.params, trims, U)
+        except TrimError as exc:
+            raise TaskError(f"wind_speed {U} m/s: no trim for these parameters: {exc}") from None
     base = trims.params
     last = None
     failures = no_body = 0
@@ -226,15 +310,13 @@ def _parameters(task: TaskConfig, trims: TrimTable, k: int, rng) -> tuple[Params
                 for key, rel in spec.items()}
         try:
             params = apply_overrides(base, over)
-            eq = find_equilibrium(params, float(trims.speeds[k]), guess=trims.equilibrium(k),
-                                  max_step=WIND_GRID)
-            return params, eq.x
+            return params, _continued_trim(params, trims, U)
         except InertiaError as exc:
             no_body, last = no_body + 1, exc
         except (ParameterError, TrimError) as exc:
             failures, last = failures + 1, exc
     raise TaskError(f"randomize {spec} gave no feasible aerostat in {failures + no_body} draws "
-                    f"at U = {trims.speeds[k]} m/s (last: {last}); narrow the ranges")
+                    f"at U = {U} m/s (last: {last}); narrow the ranges")
 
 
 def _field(cfg, bank_shape, ua, wp, rng) -> tuple[int, float]:
@@ -314,13 +396,16 @@ def _perturb(x_trim, params, pert, wp, ua, rng) -> tuple[np.ndarray, dict]:
     swing = draw() * pert["swing"]
     lateral = draw() * pert["lateral"]
     pitch = draw() * pert["pitch"]
-    height = x[lay.cm_pos][2]
+    # the swing pivots on the winch, wherever the configuration puts it: positions are taken
+    # relative to the anchor, rotated, and put back (exact for an anchor at the origin)
+    anchor = np.array(params.tether.anchor_position, float)
+    height = x[lay.cm_pos][2] - anchor[2]
     Rs = rotation_matrix(0.0, swing / height, 0.0) @ rotation_matrix(-lateral / height, 0.0, 0.0)
-    nodes = x[lay.node_pos].reshape(-1, 3)
-    x[lay.node_pos] = (nodes @ Rs.T).ravel()
+    nodes = x[lay.node_pos].reshape(-1, 3) - anchor
+    x[lay.node_pos] = (nodes @ Rs.T + anchor).ravel()
     R = Rs @ rotation_matrix(*x[lay.euler])
     leash = np.array(params.derived.leash_position)
-    conf = Rs @ x[lay.cm_pos] + R @ leash
+    conf = anchor + Rs @ (x[lay.cm_pos] - anchor) + R @ leash
     phi, theta, psi = euler_angles(R)
     theta += pitch
     x[lay.euler] = (phi, theta, psi)

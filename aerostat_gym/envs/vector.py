@@ -20,16 +20,21 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from ..checks import is_number, is_whole
+from ..checks import is_whole
 from ..sim.events import FAILURES, FIELD_END, OUTCOMES, RUNNING
 from . import reward
 from .batch import EnvBatch
-from .config import TaskConfig
+from .config import TaskConfig, TaskError
 from .env import frame
 from .episodes import reset_options
 from .render import Renderer
 
 DEFAULT_MAX_EPISODE_STEPS = 600
+#: SAME_STEP keys kept beside SyncVectorEnv's layout because :mod:`aerostat_gym.envs.sb3` reads
+#: them: the ended slots' reasons at the top level (SyncVectorEnv has them in ``final_info``
+#: only), and their new episodes' reset infos once more with this prefix
+SB3_REASONS = ("termination", "failure", "truncation")
+SB3_RESET_PREFIX = "reset_"
 
 
 class TetheredAerostatVectorEnv(VectorEnv):
@@ -41,9 +46,19 @@ class TetheredAerostatVectorEnv(VectorEnv):
     With ``autoreset_mode=AutoresetMode.DISABLED`` an ended environment waits for
     ``reset(options={"reset_mask": mask})``: until then it is not stepped, its observation
     stays the final one and it reports reward 0, ``terminated`` and ``truncated`` False (its
-    end is reported once, on the step where it happened)."""
+    end is reported once, on the step where it happened).
+
+    The infos are those of Gymnasium's ``SyncVectorEnv`` over the single environment (same
+    keys, ``_key`` masks and values): the stepped slots' step infos; in ``NEXT_STEP`` the
+    reset info of a slot that starts its next episode in this step; in ``SAME_STEP`` an ended
+    slot's step info in ``final_info`` (with ``final_obs``) and its new episode's reset info
+    in its place, plus, for the SB3 adapter, its ``termination`` / ``failure`` /
+    ``truncation`` at the top level and its reset info again prefixed ``reset_``.
+    ``step()`` before ``reset()`` raises ``gymnasium.error.ResetNeeded``, and any call but
+    ``close()`` after ``close()`` raises ``gymnasium.error.ClosedEnvironmentError``."""
 
     metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
+    _ready = False  # set by reset() once every slot has an episode, cleared by close()
 
     def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
@@ -74,25 +89,31 @@ class TetheredAerostatVectorEnv(VectorEnv):
         # ended, not stepped: NEXT_STEP resets these at the next step, DISABLED waits for reset()
         self._pending = np.zeros(num_envs, dtype=np.bool_)
         self._renderer = None
+        self._ready = False  # every slot has an episode and the env is open: step() may go on
 
     # --- Gymnasium VectorEnv API -----------------------------------------------------------
 
     def reset(self, *, seed=None, options=None):
+        self.batch.check_open("reset()")
         opts = reset_options(options)
         mask = _reset_mask(opts.pop("reset_mask", None), self.num_envs)
         seeds = _seeds(seed, self.num_envs)
-        infos = []
+        infos = {}
         for i in np.flatnonzero(mask):
             if seeds[i] is not None or self._rngs[i] is None:
                 self._rngs[i] = seeding.np_random(seeds[i])[0]
-            infos.append((i, self._reset(i, _options_for(opts, i, self.num_envs))))
+            infos = self._add_info(infos, self._reset(i, _options_for(opts, i, self.num_envs)), i)
             self._pending[i] = False
-        return self.batch.obs.copy(), _stack_infos(infos, self.num_envs)
+        self._ready = self.batch.started
+        return self.batch.obs.copy(), infos
 
     def step(self, actions):
         b = self.batch
+        if not self._ready:  # one flag per step; the reason is worked out only when it fails
+            b.check_started("step()")
         clipped = b.set_actions(actions)
         pending = self._pending.copy()
+        idle = bool(pending.any())  # NEXT_STEP resets these slots now, DISABLED holds them
         b.step(~pending)
         self._steps[~pending] += 1
         rewards = np.where(pending, 0.0, b.terms.sum(axis=1))
@@ -102,29 +123,27 @@ class TetheredAerostatVectorEnv(VectorEnv):
             & ~pending & ~terminated
         info = self._step_info(clipped, pending, terminated, truncated)
         done = terminated | truncated
-        if pending.any() and self.autoreset_mode == AutoresetMode.NEXT_STEP:
-            # these slots start their new episode now
-            resets = [(i, self._reset(i, {})) for i in np.flatnonzero(pending)]
-            info.update(_stack_infos(resets, self.num_envs, prefix="reset_"))
         for i in np.flatnonzero(~pending):
             self._noise(i)
         if self.task.reward_fn is not None:
             self._custom_rewards(rewards, pending, info)
+        if idle:  # as SyncVectorEnv stacks them: a key only where some slot stepped
+            info = _only_set(info)
         if self.autoreset_mode == AutoresetMode.NEXT_STEP:
+            for i in np.flatnonzero(pending):  # these slots start their new episode now
+                info = self._add_info(info, self._reset(i, {}), i)
             self._pending = done.copy()
         elif self.autoreset_mode == AutoresetMode.DISABLED:
             self._pending |= done
         elif done.any():
-            info["final_obs"] = _final_obs(b.obs, done)
-            info["_final_obs"] = done.copy()
-            resets = [(i, self._reset(i, {})) for i in np.flatnonzero(done)]
-            info.update(_stack_infos(resets, self.num_envs, prefix="reset_"))
+            info = self._same_step_info(info, done)
         return b.obs.copy(), rewards, terminated, truncated, info
 
     def render(self):
         """An rgb_array frame of environment 0 (None without a render_mode)."""
         if self.render_mode is None:
             return None
+        self.batch.check_started("render()")
         if self._renderer is None:
             self._renderer = Renderer(self.batch.params, "rgb_array",
                                       fps=round(1.0 / self.task.control_step))
@@ -134,6 +153,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
         if self._renderer is not None:
             self._renderer.close()
         self.batch.release()
+        self._ready = False
 
     # --- helpers ---------------------------------------------------------------------------
 
@@ -148,25 +168,46 @@ class TetheredAerostatVectorEnv(VectorEnv):
             self.batch.add_noise(i, self._rngs[i])
 
     def _step_info(self, clipped, pending, terminated, truncated) -> dict:
+        """The stepped slots' infos, each key as the single env's step info has it (masks:
+        the stepped slots): the reward terms, action_clipped, time, peak_tension, and the
+        termination (and failure) or field-end truncation reason of an ended slot (a time
+        limit, the TimeLimit wrapper's, has none)."""
         b = self.batch
         stepped = ~pending
         info = {}
         for j, k in enumerate(reward.REWARD_TERMS):
             info["reward_" + k] = np.where(stepped, b.terms[:, j], 0.0)
             info["_reward_" + k] = stepped
-        info["peak_tension"], info["_peak_tension"] = np.where(stepped, b.peak, 0.0), stepped
         info["action_clipped"], info["_action_clipped"] = clipped & stepped, stepped
-        ended = terminated | truncated
-        if ended.any():
-            key = {True: "termination", False: "truncation"}
-            for i in np.flatnonzero(ended):
-                name = key[bool(terminated[i])]
-                code = int(b.code[i])
-                reason = OUTCOMES.get(code, "time_limit")
-                _put(info, name, i, reason, self.num_envs)
-                if code in FAILURES:
-                    _put(info, "failure", i, reason, self.num_envs)
+        info["time"], info["_time"] = np.where(stepped, b.time, 0.0), stepped
+        info["peak_tension"], info["_peak_tension"] = np.where(stepped, b.peak, 0.0), stepped
+        ended = terminated | (truncated & (b.code == FIELD_END))
+        for i in np.flatnonzero(ended):
+            code = int(b.code[i])
+            _put(info, "termination" if terminated[i] else "truncation", i, OUTCOMES[code],
+                 self.num_envs)
+            if code in FAILURES:
+                _put(info, "failure", i, OUTCOMES[code], self.num_envs)
         return info
+
+    def _same_step_info(self, info: dict, done: np.ndarray) -> dict:
+        """SAME_STEP's layout, SyncVectorEnv's: an ended slot's step info moves to
+        ``final_info`` (with ``final_obs``) and its new episode's reset info takes its place;
+        plus the :data:`SB3_REASONS` and :data:`SB3_RESET_PREFIX` keys the SB3 adapter reads."""
+        final, out = {}, {}
+        for key in [k for k in info if not k.startswith("_")]:
+            for part, rows in ((final, info["_" + key] & done), (out, info["_" + key] & ~done)):
+                if rows.any():
+                    part[key], part["_" + key] = _masked(info[key], rows), rows
+        out["final_obs"], out["_final_obs"] = _final_obs(self.batch.obs, done), done.copy()
+        out["final_info"], out["_final_info"] = final, done.copy()
+        out.update({key: final[key].copy() for k in SB3_REASONS if k in final
+                    for key in (k, "_" + k)})
+        for i in np.flatnonzero(done):
+            started = self._reset(i, {})
+            out = self._add_info(out, started, i)
+            out = self._add_info(out, {SB3_RESET_PREFIX + k: v for k, v in started.items()}, i)
+        return out
 
     def _custom_rewards(self, rewards, pending, info) -> None:
         """Replace the stepped slots' rewards by the user's reward_fn (env i's own info)."""
@@ -205,15 +246,22 @@ def _reset_mask(mask, n: int) -> np.ndarray:
     return arr
 
 
-def _seeds(seed, n):
+def _seeds(seed, n: int) -> list:
+    """One seed (or None) per environment: None (all unseeded), an integer s >= 0
+    (environment i gets s + i), or a list, tuple or array of n integers >= 0 or None;
+    anything else is a TaskError naming it."""
     if seed is None:
         return [None] * n
-    if isinstance(seed, (int, np.integer)):
+    if is_whole(seed, 0):
         return [int(seed) + i for i in range(n)]
-    seeds = list(seed)
+    seeds = list(seed) if isinstance(seed, (list, tuple, np.ndarray)) else None
+    if seeds is None or not all(s is None or is_whole(s, 0) for s in seeds):
+        raise TaskError(f"seed must be None, an integer >= 0 or a list of {n} of them (None "
+                        f"for an unseeded environment), got {seed!r:.80}")
     if len(seeds) != n:
-        raise ValueError(f"expected {n} seeds, got {len(seeds)}")
-    return seeds
+        raise TaskError(f"seed: expected a list of {n} seeds (one per environment), got "
+                        f"{len(seeds)}: {seed!r:.80}")
+    return [None if s is None else int(s) for s in seeds]
 
 
 def _options_for(options: dict, i: int, n: int) -> dict:
@@ -231,19 +279,18 @@ def _put(info, key, i, value, n):
     info["_" + key][i] = True
 
 
-def _stack_infos(pairs, n, prefix=""):
-    """Gymnasium's vector info layout: per key an array over environments and a mask."""
-    out = {}
-    for i, d in pairs:
-        for k, v in d.items():
-            key = prefix + k
-            if key not in out:
-                numeric = is_number(v)
-                out[key] = np.zeros(n) if numeric else np.array([None] * n, dtype=object)
-                out["_" + key] = np.zeros(n, dtype=bool)
-            out[key][i] = v
-            out["_" + key][i] = True
+def _masked(values: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """``values`` on ``rows``, the empty value elsewhere (0 / False, None for objects), as
+    Gymnasium's info stacking leaves the slots that lack a key."""
+    out = np.full_like(values, None) if values.dtype == object else np.zeros_like(values)
+    out[rows] = values[rows]
     return out
+
+
+def _only_set(info: dict) -> dict:
+    """``info`` without the keys that no slot has (all-False mask)."""
+    names = [k for k in info if not k.startswith("_") and info["_" + k].any()]
+    return {key: info[key] for k in names for key in (k, "_" + k)}
 
 
 def make_vec(num_envs: int = 1, **kwargs) -> TetheredAerostatVectorEnv:

@@ -44,7 +44,11 @@ def field_extent(params: Params, dz: float) -> dict:
     clipped into the field)."""
     z0 = float(params.tether.anchor_position[2])
     z_top = z0 + highest_point(params)
-    z_max = z0 + dz * (math.ceil((z_top - z0) / dz) + 1)
+    rows = (z_top - z0) / dz
+    if not math.isfinite(rows):
+        raise ValueError(f"turbulence dz = {dz!r} m is too small for the field's "
+                         f"{z_top - z0:g} m of heights")
+    z_max = z0 + dz * (math.ceil(rows) + 1)
     ref = min(max(params.wind.turbulence_reference_height, z0), z_max)
     return {"z_min": z0, "z_max": z_max, "reference_height": ref,
             "downwind_extent": float(params.winch.max_length + params.aerostat.length)}

@@ -21,6 +21,32 @@ from numba import njit
 
 from .spectra import temporal_psd
 
+#: [bytes] the most memory turbulence fields may take at once (the environment's bank, or one
+#: field of the simulator): float64 u, v, w at every height and sample. The default bank takes
+#: 78 MiB (8 fields of 88 heights x 4,640 samples) and one at 100 m/s on a 1 km tether under
+#: 1 GiB; a grid past a few GiB is a typo (dz in km, an extent in mm) that NumPy would only
+#: refuse after minutes of synthesis, and the synthesis needs about four fields more on top.
+MAX_FIELD_BYTES = 4 * 2**30
+
+
+def field_bytes(cfg, samples: float, count: int = 1) -> float:
+    """Bytes of ``count`` float64 (u, v, w) fields of ``cfg``'s height grid (a
+    TurbulenceConfig) with ``samples`` along-wind or time samples each."""
+    return float(count) * cfg.heights()[2] * float(samples) * 3 * 8
+
+
+def check_field_size(cfg, samples: float, count: int = 1, detail: str = "") -> None:
+    """Refuse (ValueError naming dz, the heights and the memory) ``count`` fields of ``samples``
+    samples that would take more than :data:`MAX_FIELD_BYTES`, before anything is allocated;
+    ``detail`` says where the samples come from."""
+    nbytes = field_bytes(cfg, samples, count)
+    if not nbytes <= MAX_FIELD_BYTES:
+        z0, dz, nz = cfg.heights()
+        raise ValueError(f"{count} field(s) of {nz} heights (dz = {dz:g} m from z_min = {z0:g} "
+                         f"to z_max = {cfg.z_max:g} m) x {samples:.4g} samples{detail} would "
+                         f"take {nbytes / 2**30:.3g} GiB, above the {MAX_FIELD_BYTES / 2**30:g} "
+                         f"GiB cap (aerostat_gym.wind.synthesis.MAX_FIELD_BYTES)")
+
 
 def iec_coherence(f, r, U: float, a: float = 12.0, Lc: float = 340.2):
     """IEC 61400-1 Ed.3 exponential coherence (magnitude, not squared).
@@ -139,6 +165,7 @@ def veers_field(cfg, U: float, n: int, rng: np.random.Generator) -> np.ndarray:
     ndarray, shape (nz, n, 3)
         C-contiguous, the layout :func:`aerostat_gym.physics.wind.air_velocity` reads.
     """
+    check_field_size(cfg, n)
     _, dz, nz = cfg.heights()
     Ls, Lcs = cfg.scales_8785c(), cfg.coherence_lengths()
     powers = np.stack([
