@@ -384,7 +384,7 @@ class LQGPolicy:
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """(actions, state): actions (1,) or (N, 1) float32 in [-1, 1]; state to pass back."""
-        obs2, single = as_batch(observation, float)
+        obs2, single = as_batch(observation, float, episode_start)
         if obs2.ndim != 2 or obs2.shape[1] < N_OBS:
             raise ValueError(f"LQGPolicy needs the standard observation ({N_OBS} channels), got "
                              f"shape {np.shape(observation)}")
@@ -392,7 +392,7 @@ class LQGPolicy:
         S = self._state(state, N)
         start = np.isnan(S[:, 0])
         if episode_start is not None:
-            start |= np.broadcast_to(np.asarray(episode_start, bool).reshape(-1), (N,))
+            start |= np.asarray(episode_start, bool).reshape(-1)
         wind = obs2[:, WIND_CHANNEL] * CHANNELS[WIND_CHANNEL].scale
         S[start] = 0.0
         S[start, self.n + 1] = wind[start]

@@ -702,7 +702,7 @@ class LQRPolicy:
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """(actions, state): actions (1,) for one observation or (N, 1) for a batch, float32 in
         [-1, 1]; state is the (N,) array of integral states to pass back next step."""
-        obs2, single = as_batch(observation, float)
+        obs2, single = as_batch(observation, float, episode_start)
         if obs2.ndim != 2 or obs2.shape[1] < self.obs_size:
             raise ValueError(
                 f"LQRPolicy needs the full-state observation of length {self.obs_size} "
@@ -714,8 +714,7 @@ class LQRPolicy:
             raise ValueError(f"state must hold one integral per environment, shape ({N},), got "
                              f"{np.shape(state)}")
         if episode_start is not None:
-            start = np.asarray(episode_start, dtype=bool).reshape(-1)
-            z[np.broadcast_to(start, (N,))] = 0.0
+            z[np.asarray(episode_start, dtype=bool).reshape(-1)] = 0.0
         U = obs2[:, OBS_FULL_WIND]
         dx = obs2[:, OBS_FULL_STATE:OBS_FULL_STATE + self.layout.size].copy()
         ipsi = self.layout.euler.start + 2

@@ -32,9 +32,11 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.reference import reference_periods
-from ..envs.config import check_control_step
+from ..envs.config import TaskError, check_control_step
+from ..envs.config import _range as wind_speed_range
 from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION, as_batch, check_obs_noise
 from ..params import Params, as_params
+from ..physics.wind import MAX_WIND_SPEED
 from ..resources import SHIPPED_POLICY, shipped_path
 from .lqg import LQGPolicy, LQGSchedule
 from .lqr import LQRPolicy, LQRSchedule, schedule_speeds
@@ -66,7 +68,7 @@ class PassivePolicy:
     obs_dim = N_OBS
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        obs, single = as_batch(observation)
+        obs, single = as_batch(observation, episode_start=episode_start)
         return to_actions(np.zeros(len(obs)), single), state
 
 
@@ -106,7 +108,7 @@ class TensionFeedbackPolicy:
         return cls(gain=gain, restore_time=restore, max_speed=v_max)
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        obs, single = as_batch(observation)
+        obs, single = as_batch(observation, episode_start=episode_start)
         dT_kN = obs[:, OBS_DTENSION] * CHANNELS[OBS_DTENSION].scale / 1.0e3
         dL = obs[:, OBS_DLENGTH] * CHANNELS[OBS_DLENGTH].scale
         v = self.gain * dT_kN - dL / self.restore_time
@@ -193,6 +195,7 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     """
     params = as_params(params, PolicyError)
     check_control_step(dt)  # the step the controllers are designed for
+    wind_range = _wind_range(wind_range)
     if isinstance(name, os.PathLike):
         name = os.fspath(name)
     if not isinstance(name, str):
@@ -229,6 +232,17 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise PolicyError(f"unknown policy {name!r}{hint}: use one of "
                       f"{BASELINES + tuple(SHIPPED)} or a path to a .zip")
+
+
+def _wind_range(value) -> tuple[float, float] | None:
+    """The wind speeds [m/s] a scheduled design must cover (None: its default), checked as the
+    task's ``wind_speed`` is: a number or a (low, high) pair in [0, MAX_WIND_SPEED]."""
+    if value is None:
+        return None
+    try:
+        return wind_speed_range("wind_range", value, hi_max=MAX_WIND_SPEED)
+    except TaskError as exc:
+        raise PolicyError(str(exc)) from None
 
 
 def _lqg(kind: str, params: Params, dt: float, obs_noise) -> LQGPolicy:

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..checks import is_finite_number
-from ..envs.spaces import N_OBS
+from ..envs.spaces import N_OBS, as_batch
 from .sb3io import CommandShaper, PolicyError, check_lowpass_on
 
 #: Baselines that read the standard observation only, allowed as residual bases.
@@ -184,12 +184,11 @@ class ShapedPolicy:
         self.obs_dim = getattr(policy, "obs_dim", None)
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
+        _, single = as_batch(observation, episode_start=episode_start)
         state = state if isinstance(state, dict) else {}
         a, inner = self.policy.predict(observation, state=state.get("inner"),
                                        episode_start=episode_start, deterministic=deterministic)
         a = np.asarray(a, np.float64).reshape(-1)
-        start = None if episode_start is None else np.broadcast_to(
-            np.asarray(episode_start, bool).reshape(-1), a.shape)
+        start = None if episode_start is None else np.asarray(episode_start, bool).reshape(-1)
         cmd, filtered = self.shaper(a, np.zeros_like(a), state.get("filter"), start)
-        return (cmd[0] if np.ndim(observation) == 1 else cmd), {"inner": inner,
-                                                                "filter": filtered}
+        return (cmd[0] if single else cmd), {"inner": inner, "filter": filtered}

@@ -166,7 +166,7 @@ class SB3Policy:
         self.plain = self.frame_stack == 1 and residual is None and not self.recurrent
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        obs, single = as_batch(observation)
+        obs, single = as_batch(observation, episode_start=episode_start)
         obs = policy_obs(self, obs)
         if self.plain:
             if self.norm is not None:
@@ -177,7 +177,7 @@ class SB3Policy:
         state = dict(state) if isinstance(state, dict) else {}
         start = (np.ones(n, bool) if episode_start is None and not state
                  else np.zeros(n, bool) if episode_start is None
-                 else np.broadcast_to(np.asarray(episode_start, bool).reshape(-1), (n,)).copy())
+                 else np.asarray(episode_start, bool).reshape(-1).copy())
         if self.residual is not None:  # the base reads the raw observation first, as in training
             base, shaper = self.residual
             b, state["base"] = base.predict(obs[:, :N_OBS], state=state.get("base"),
@@ -317,19 +317,57 @@ def read_wrappers(path: str | Path) -> dict:
     return wrappers
 
 
+def check_model_file(path: str | Path, what: str = "policy file") -> Path:
+    """``path`` as the Path of a file that can be a saved Stable-Baselines3 model (a .zip
+    archive), else a PolicyError naming it as ``what`` and what is wrong."""
+    path = Path(path)
+    if path.is_dir():
+        raise PolicyError(f"{path} is a directory, not a {what}: give the model's .zip")
+    if not path.is_file():
+        raise PolicyError(f"{what} not found: {path}")
+    if not zipfile.is_zipfile(path):
+        raise PolicyError(f"{what} {path} is not a Stable-Baselines3 model (.zip archive): "
+                          "corrupt or wrong file")
+    return path
+
+
+def _default_policy(algo) -> type:
+    """The policy class an algorithm builds by default (RecurrentPPO's is its LSTM one)."""
+    aliases = algo.policy_aliases
+    return aliases["MlpLstmPolicy"] if "MlpLstmPolicy" in aliases else aliases["MlpPolicy"]
+
+
+def saved_algorithm(path: str | Path, what: str = "policy file") -> str | None:
+    """The name of the algorithm class (``"PPO"``, ``"SAC"``, ``"TD3"``, ``"RecurrentPPO"``)
+    that saved the model at ``path`` (checked with :func:`check_model_file`), read from its
+    policy class without building the model; None when that class cannot be read or belongs
+    to none of them. A PolicyError naming the file as ``what`` when it holds no model."""
+    from stable_baselines3.common.save_util import load_from_zip_file
+
+    path = check_model_file(path, what)
+    try:
+        data, _, _ = load_from_zip_file(path, device="cpu")
+    except Exception as exc:  # noqa: BLE001 - any unreadable archive is the same refusal
+        raise PolicyError(f"cannot read the {what} {path} as a Stable-Baselines3 model: "
+                          f"{type(exc).__name__}: {exc}"[:300]) from None
+    if not data:
+        raise PolicyError(f"{what} {path} is a .zip archive but not a Stable-Baselines3 model "
+                          "(it has no model data): wrong file")
+    policy = data.get("policy_class")
+    if not isinstance(policy, type):
+        return None
+    # RecurrentPPO's policy is an actor-critic too: the most derived default names the algorithm
+    bases = [(len(_default_policy(a).__mro__), a.__name__) for a in _algorithms()
+             if issubclass(policy, _default_policy(a))]
+    return max(bases)[1] if bases else None
+
+
 def load_sb3(path: str | Path, residual_factory=None) -> SB3Policy:
     """Load a saved model (+ its ``_vecnormalize.pkl`` and ``_wrappers.json``); clear errors
     for a missing or corrupt file. ``residual_factory(spec)`` turns the saved residual block
     into (base policy, :class:`CommandShaper`), validating it (required for a residual
     model)."""
-    path = Path(path)
-    if path.is_dir():
-        raise PolicyError(f"{path} is a directory, not a policy file: give the model's .zip")
-    if not path.is_file():
-        raise PolicyError(f"policy file not found: {path}")
-    if not zipfile.is_zipfile(path):
-        raise PolicyError(f"{path} is not a Stable-Baselines3 model (.zip archive): corrupt or "
-                          "wrong file")
+    path = check_model_file(path)
     errors = []
     algos = _algorithms()
     for Algo in algos:

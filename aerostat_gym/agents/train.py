@@ -51,6 +51,7 @@ wrappers.json``), which ``load_policy`` (and so
 from __future__ import annotations
 
 import ast
+import inspect
 import json
 import platform
 import shlex
@@ -82,12 +83,15 @@ from .sb3io import (
     clean_wrappers,
     find_vecnormalize,
     save_model,
+    saved_algorithm,
     vecnormalize_path,
     write_wrappers,
 )
 from .score_reward import check_score_reward, score_reward_vec_env
 
 ALGOS = ("ppo", "sac", "td3", "rppo")
+#: The class of each algorithm (Stable-Baselines3's, sb3-contrib's RecurrentPPO).
+ALGO_CLASSES = {"ppo": "PPO", "sac": "SAC", "td3": "TD3", "rppo": "RecurrentPPO"}
 #: Keys of a zoo block that configure the run rather than the algorithm's constructor.
 RESERVED = {"n_timesteps", "n_envs", "policy", "normalize", "noise_type", "noise_std",
             "policy_kwargs"}
@@ -163,7 +167,137 @@ def normalize_kwargs(hp: dict) -> dict | None:
         raise TrainingError(f"normalize must be true, false or \"dict(...)\", got {value!r}")
     if kw is not None and "gamma" in hp:
         kw["gamma"] = hp["gamma"]
+    if kw:
+        _check_normalize(kw)
     return kw
+
+
+def _check_normalize(kw: dict) -> None:
+    """VecNormalize's keyword arguments: names of its signature, values in their ranges."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    known = sorted(set(inspect.signature(VecNormalize).parameters) - {"venv"})
+    unknown = sorted(set(kw) - set(known))
+    if unknown:
+        raise TrainingError(f"normalize: unknown VecNormalize argument(s) {unknown}; it takes "
+                            f"{known}")
+    _check_ranges(kw, NORMALIZE_RANGES, "normalize's ")
+
+
+def _unit_interval(v) -> bool:
+    return is_finite_number(v) and 0 < v <= 1
+
+
+def _positive(v) -> bool:
+    return is_finite_number(v) and v > 0
+
+
+def _non_negative(v) -> bool:
+    return is_finite_number(v) and v >= 0
+
+
+def _train_freq(v) -> bool:
+    """An off-policy update period: a step count, or [count, "step" | "episode"]."""
+    return is_whole(v) or (isinstance(v, (list, tuple)) and len(v) == 2 and is_whole(v[0])
+                           and v[1] in ("step", "episode"))
+
+
+def _sac_entropy(v) -> bool:
+    """SAC's entropy weight: learned ("auto", or "auto_X" from X > 0) or fixed >= 0."""
+    if isinstance(v, str) and v.startswith("auto"):
+        _, _, start = v.partition("_")
+        try:
+            return _positive(float(start or 1.0))
+        except ValueError:
+            return False
+    return _non_negative(v)
+
+
+POSITIVE = (_positive, "a finite number > 0")
+NON_NEGATIVE = (_non_negative, "a finite number >= 0")
+OPTIONAL_POSITIVE = (lambda v: v is None or _positive(v), "null or a finite number > 0")
+COUNT = (is_whole, "an integer >= 1")
+#: What each numeric hyperparameter must be, checked before anything is built (SB3 takes a NaN,
+#: a discount above 1 or a negative weight as given, and fails or diverges in its first update).
+#: A key is checked where the algorithm takes it; any other is SB3's to refuse.
+HYPERPARAMETER_RANGES = {
+    "gamma": (_unit_interval, "a discount in (0, 1]"),
+    "gae_lambda": (_unit_interval, "a number in (0, 1]"),
+    "tau": (_unit_interval, "a soft-update rate in (0, 1]"),
+    "learning_rate": POSITIVE,
+    "clip_range": POSITIVE,
+    "clip_range_vf": OPTIONAL_POSITIVE,
+    "target_kl": OPTIONAL_POSITIVE,
+    "max_grad_norm": POSITIVE,
+    "ent_coef": NON_NEGATIVE,
+    "vf_coef": NON_NEGATIVE,
+    "target_policy_noise": NON_NEGATIVE,
+    "target_noise_clip": NON_NEGATIVE,
+    "n_steps": COUNT,
+    "batch_size": COUNT,
+    "n_epochs": COUNT,
+    "buffer_size": COUNT,
+    "policy_delay": COUNT,
+    "target_update_interval": COUNT,
+    "learning_starts": (lambda v: is_whole(v, 0), "an integer >= 0"),
+    "gradient_steps": (lambda v: is_whole(v, -1),
+                       "an integer >= -1 (-1: one update per environment step)"),
+    "train_freq": (_train_freq, "an integer >= 1 or [n, step|episode]"),
+}
+#: Per algorithm, the rules that differ from (or add to) :data:`HYPERPARAMETER_RANGES`.
+ALGO_RANGES = {
+    "sac": {"ent_coef": (_sac_entropy, "'auto', 'auto_X' (X > 0) or a finite number >= 0")},
+    "td3": {"noise_std": NON_NEGATIVE},
+}
+#: VecNormalize's arguments (``normalize``'s keys) that have a range.
+NORMALIZE_RANGES = {
+    "gamma": HYPERPARAMETER_RANGES["gamma"],
+    "epsilon": POSITIVE,
+    "clip_obs": POSITIVE,
+    "clip_reward": POSITIVE,
+    **{key: (lambda v: isinstance(v, bool), "true or false")
+       for key in ("norm_obs", "norm_reward", "training")},
+}
+
+
+def _check_ranges(block: dict, rules: dict, prefix: str = "") -> None:
+    """Each key of ``block`` that has a rule in ``rules`` (test, what it must be) passes it."""
+    for key, (ok, must) in rules.items():
+        if key in block and not ok(block[key]):
+            raise TrainingError(f"{prefix}{key} must be {must}, got {block[key]!r}")
+
+
+def _refused(algo: str, why: str) -> TrainingError:
+    return TrainingError(f"{algo.upper()} refuses the hyperparameters: {why}")
+
+
+def check_hyperparams(algo: str, hp: dict) -> dict | None:
+    """The zoo block's numeric hyperparameters checked against their ranges (the keys the
+    algorithm takes) and its ``normalize`` against VecNormalize's signature, before anything
+    is built; returns the VecNormalize keyword arguments (None: no normalisation)."""
+    taken = set(inspect.signature(_algorithm(algo).__init__).parameters)
+    extra = ALGO_RANGES.get(algo, {})
+    rules = {k: r for k, r in {**HYPERPARAMETER_RANGES, **extra}.items()
+             if k in taken or k in extra}
+    try:
+        _check_ranges(hp, rules)
+        return normalize_kwargs(hp)
+    except TrainingError as exc:
+        raise _refused(algo, str(exc)) from None
+
+
+def check_resume(algo: str, resume) -> Path:
+    """The checkpoint to continue from: a Stable-Baselines3 model that ``algo`` saved."""
+    try:
+        found = saved_algorithm(resume, "checkpoint to resume")
+    except PolicyError as exc:
+        raise TrainingError(str(exc)) from None
+    if found is not None and found != ALGO_CLASSES[algo]:
+        saved_by = next((a for a, name in ALGO_CLASSES.items() if name == found), found)
+        raise TrainingError(f"the checkpoint to resume {resume} is a {found} model, but the "
+                            f"algorithm is {algo} ({ALGO_CLASSES[algo]}): resume it with "
+                            f"--algo {saved_by}")
+    return Path(resume)
 
 
 def _algorithm(algo: str):
@@ -272,19 +406,18 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     task_id, hp, project = load_hyperparams(algo, hyperparams)
     n_envs = _count("n_envs", hp.get("n_envs", 8) if n_envs is None else n_envs)
     timesteps = _count("timesteps", hp.get("n_timesteps", 1e6) if timesteps is None else timesteps)
+    normalize = check_hyperparams(algo, hp)
+    resume = check_resume(algo, resume) if resume else None
     env_kwargs = {**TASKS[task_id][0], **(project.get("env_kwargs") or {})}
     if params is not None:
         env_kwargs["params"] = params
         env_kwargs["wind_speed"] = held_training_winds(env_kwargs)
     run = Path(run_dir or f"runs/train/{algo}_seed{seed}_{time.strftime('%Y%m%d-%H%M%S')}")
-    run.mkdir(parents=True, exist_ok=True)
     if threads:
         torch.set_num_threads(threads)
     set_random_seed(seed)
     wrappers = wrapper_spec(project, env_kwargs)
     base = residual_base(wrappers, env_kwargs)
-    if resume and not Path(resume).is_file():
-        raise TrainingError(f"checkpoint to resume not found: {resume}")
     try:
         score = check_score_reward(project.get("score_reward"))
     except PolicyError as exc:
@@ -293,13 +426,18 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
                                   hp.get("policy", "MlpPolicy"), wrappers)
     if asymmetric:  # the critic's privileged channels
         env_kwargs["observation"] = "full"
-    venv = make_training_env(n_envs, seed, env_kwargs, normalize_kwargs(hp), wrappers, base,
-                             stats=vecnormalize_path(Path(resume)) if resume else None,
+    venv = make_training_env(n_envs, seed, env_kwargs, normalize, wrappers, base,
+                             stats=vecnormalize_path(resume) if resume else None,
                              score_reward=score)
+    try:  # the run directory is made once the model is built: a refused start leaves none
+        model = _model(algo, hp, venv, seed, run, resume,
+                       actor_only=_actor_channels(venv, wrappers, base) if asymmetric else None)
+        make_run_dir(run)
+    except TrainingError:
+        venv.close()
+        raise
     _write_run_files(run, algo, task_id, {task_id: hp, PROJECT_BLOCK: project}, venv, seed,
                      n_envs, timesteps)
-    model = _model(algo, hp, venv, seed, run, resume,
-                   actor_only=_actor_channels(venv, wrappers, base) if asymmetric else None)
     freq = _count("eval_freq", eval_freq or project.get("eval_freq", 50_000))
     suite_cb = suite_eval_callback(project.get("eval_suite", "tiny"), max(freq // n_envs, 1),
                                    run, env_kwargs.get("params"), on_eval, wrappers, base)
@@ -453,20 +591,35 @@ def _actor_channels(venv, wrappers: dict, base) -> list[int]:
     return actor_channels(venv.observation_space.shape[0], base.n_features if observe else 0)
 
 
-def _model(algo, hp, venv, seed, run, resume, actor_only=None):
-    """The SB3 model (``actor_only``: the channels of an asymmetric actor-critic's actor); a
-    hyperparameter the algorithm refuses is a TrainingError naming the algorithm and its
-    message."""
+def make_run_dir(run: Path) -> None:
+    """Create the run directory (and its parents), or a TrainingError naming it."""
     try:
-        return _build_model(algo, hp, venv, seed, run, resume, actor_only)
-    except (TypeError, ValueError, AssertionError, KeyError) as exc:
-        raise TrainingError(f"{algo.upper()} refuses the hyperparameters: "
-                            f"{type(exc).__name__}: {exc}") from None
+        run.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise TrainingError(f"cannot create the run directory {run}: "
+                            f"{exc.strerror or exc}") from None
 
 
-def _build_model(algo, hp, venv, seed, run, resume, actor_only):
-    Algo = _algorithm(algo)
+def _model(algo, hp, venv, seed, run, resume, actor_only=None):
+    """The SB3 model (``actor_only``: the channels of an asymmetric actor-critic's actor), or
+    the one in the checkpoint ``resume``; a hyperparameter the algorithm refuses is a
+    TrainingError naming the algorithm and its message, a checkpoint it cannot continue one
+    naming the checkpoint."""
     tb = _tensorboard_dir(run)
+    if resume:  # the VecNormalize statistics saved beside it are already in venv
+        try:
+            return _algorithm(algo).load(resume, env=venv, seed=seed, tensorboard_log=tb)
+        except (TypeError, ValueError, AssertionError, KeyError, AttributeError) as exc:
+            raise TrainingError(f"cannot continue the checkpoint {resume} on this training "
+                                f"configuration: {type(exc).__name__}: {exc}") from None
+    try:
+        return _build_model(algo, hp, venv, seed, tb, actor_only)
+    except (TypeError, ValueError, AssertionError, KeyError) as exc:
+        raise _refused(algo, f"{type(exc).__name__}: {exc}") from None
+
+
+def _build_model(algo, hp, venv, seed, tb, actor_only):
+    Algo = _algorithm(algo)
     kwargs = {k: v for k, v in hp.items() if k not in RESERVED}
     if hp.get("policy_kwargs") or actor_only:
         pk = dict(hp.get("policy_kwargs") or {})
@@ -478,8 +631,6 @@ def _build_model(algo, hp, venv, seed, run, resume, actor_only):
 
         kwargs["action_noise"] = NormalActionNoise(np.zeros(1), hp.get("noise_std", 0.1) *
                                                    np.ones(1))
-    if resume:  # the VecNormalize statistics saved beside it are already in venv
-        return Algo.load(Path(resume), env=venv, seed=seed, tensorboard_log=tb)
     policy = hp.get("policy", "MlpLstmPolicy" if algo == "rppo" else "MlpPolicy")
     if actor_only:
         policy = asymmetric_policy_class()

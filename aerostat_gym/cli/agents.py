@@ -26,6 +26,7 @@ from .common import (
     add_config,
     config_label,
     nonneg_float,
+    output_dir,
     params_from_args,
     positive_int,
     seed_int,
@@ -110,9 +111,10 @@ def _evaluate_command(args) -> int:
     _check_policies(args.policy)
     params = params_from_args(args)
     _check_suite_winds(args.suite, args.speeds, params)
+    out = output_dir(args.out)
     results = run_evaluations(args.policy, args.suite, progress=not args.json, params=params,
                               speeds=args.speeds)
-    md = write_report(results, args.out, f"Evaluation on suite `{args.suite}`",
+    md = write_report(results, out, f"Evaluation on suite `{args.suite}`",
                       "aerostat-gym " + " ".join(sys.argv[1:]), plots=not args.no_plots)
     if args.json:
         print(json.dumps(jsonable(results, protocol_for(results)), indent=1))
@@ -128,7 +130,8 @@ def _evaluate_command(args) -> int:
 
 def add_demo_parser(sub) -> None:
     p = sub.add_parser("demo", help="the main job: trim, stability summary, shipped policy vs "
-                                    "baselines on the tiny suite, report in runs/demo/")
+                                    "baselines on the tiny suite (baselines only on a "
+                                    "non-baseline aerostat), report in runs/demo/")
     p.add_argument("--wind", type=nonneg_float, default=10.0,
                    help="wind speed of the summary [m/s]")
     p.add_argument("--policy", default="shipped",
@@ -147,13 +150,20 @@ def _demo_command(args) -> int:
     _check_policies([args.policy])
     params = params_from_args(args)
     policies = ["passive", "lqr"]
-    if params == load_params() or args.policy != "shipped":
-        policies.append(args.policy)  # the shipped policy was trained on the baseline
+    # the shipped policy was trained on the baseline aerostat: on another one it is left out
+    shipped_left_out = args.policy == "shipped" and params != load_params()
+    if not shipped_left_out:
+        policies.append(args.policy)
     _check_suite_winds(args.suite, args.speeds, params)
+    out = output_dir(args.out)
     summary = demo_summary(params, args.wind, config_label(args))
+    if shipped_left_out:
+        summary.append("  shipped policy left out: it was trained on the baseline aerostat; "
+                       "this run compares the baselines (passive, lqr) only (--policy "
+                       "PATH.zip adds a policy trained on this aerostat)")
     print("\n".join(summary))
     results = run_evaluations(policies, args.suite, params=params, speeds=args.speeds)
-    md = write_report(results, args.out, "aerostat-gym demo",
+    md = write_report(results, out, "aerostat-gym demo",
                       "aerostat-gym demo " + " ".join(sys.argv[1:]),
                       preamble=["## Trim and linear stability", "", "```", *summary, "```", ""])
     print()
@@ -177,8 +187,7 @@ def demo_summary(params, wind: float, label: str = "baseline") -> list[str]:
         m = ana.find(subset, label_)
         if m is not None:
             name = {"long": "longitudinal", "lat": "lateral"}[subset]
-            lines.append(f"    {name:12s} {label_:13s} period {m.period:7.2f} s  "
-                         f"damping {m.zeta:.3f}")
+            lines.append(f"    {name:12s} {label_:13s} {m.describe()}")
     return lines
 
 

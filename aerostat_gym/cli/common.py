@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import tempfile
 from pathlib import Path
 
 from tqdm import tqdm
@@ -88,6 +89,19 @@ def existing_file(text: str) -> str:
     if not Path(text).is_file():
         raise argparse.ArgumentTypeError(f"file not found: {text!r}")
     return text
+
+
+def output_dir(path: str, option: str = "--out") -> Path:
+    """The directory a command writes into, created (with its parents) and checked writable
+    before the command's work, so that a long run never ends on a path it cannot write."""
+    out = Path(path)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=out):
+            pass
+    except OSError as exc:
+        raise ValueError(f"{option} {path}: cannot write there ({exc.strerror or exc})") from None
+    return out
 
 
 def config_source(text: str) -> str:

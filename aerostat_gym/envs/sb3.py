@@ -2,14 +2,57 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
+from ..checks import is_whole
 from .vector import TetheredAerostatVectorEnv
 
 
+def check_seed(seed) -> int | None:
+    """The adapter's seed: None (unseeded) or an integer >= 0 (environment i is seeded with
+    seed + i at the next reset, as SB3's ``VecEnv.seed`` does), else a ValueError naming it."""
+    if seed is not None and not is_whole(seed, 0):
+        raise ValueError(f"seed must be None or an integer >= 0, got {seed!r}")
+    return seed
+
+
+def check_set_options(options, num_envs: int) -> list[dict]:
+    """SB3's ``set_options`` argument as one dict of reset options per environment: None (no
+    options), one dict for every environment, or a list of ``num_envs`` dicts."""
+    if options is None:
+        return [{} for _ in range(num_envs)]
+    if isinstance(options, Mapping):
+        return [dict(options) for _ in range(num_envs)]
+    if (isinstance(options, (list, tuple)) and len(options) == num_envs
+            and all(isinstance(o, Mapping) for o in options)):
+        return [dict(o) for o in options]
+    raise ValueError(f"set_options takes a dict of reset options or a list of {num_envs} "
+                     f"(one per environment), got {options!r:.80}")
+
+
+def env_infos(info: dict, num_envs: int, prefix: str = "") -> list[dict]:
+    """Gymnasium's stacked vector info (per key an array over environments and a ``_key``
+    mask) as one dict per environment, the keys that start with ``prefix`` (stripped)."""
+    out = [{} for _ in range(num_envs)]
+    for key, values in info.items():
+        if key.startswith("_") or not key.startswith(prefix):
+            continue
+        for i in np.flatnonzero(info["_" + key]):
+            out[i][key[len(prefix):]] = values[i]
+    return out
+
+
 def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
-    """A Stable-Baselines3 ``VecEnv`` over one compiled batch of ``num_envs`` environments."""
+    """A Stable-Baselines3 ``VecEnv`` over one compiled batch of ``num_envs`` environments.
+
+    As SB3's ``DummyVecEnv``: ``seed`` (and ``seed()``) and ``set_options()`` apply at the next
+    ``reset()`` only, then are cleared; ``reset_infos`` holds each environment's reset info
+    (after an automatic reset inside ``step``, the new episode's)."""
     from stable_baselines3.common.vec_env import VecEnv
+
+    check_seed(seed)
 
     class SB3VecEnv(VecEnv):
         """SB3 adapter: same-step autoreset, ``terminal_observation`` and
@@ -24,11 +67,27 @@ def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
             if seed is not None:
                 self.seed(seed)
 
+        def set_options(self, options=None) -> None:
+            self._options = check_set_options(options, self.num_envs)
+
         def reset(self):
-            seeds = self._seeds if any(s is not None for s in self._seeds) else None
-            obs, info = self.venv.reset(seed=seeds)
-            self._seeds = [None] * self.num_envs
-            self.reset_infos = [{} for _ in range(self.num_envs)]
+            if any(self._options):
+                obs = self._reset_each()
+            else:
+                obs, info = self.venv.reset(seed=self._seeds)
+                self.reset_infos = env_infos(info, self.num_envs)
+            self._reset_seeds()
+            self._reset_options()
+            return obs
+
+        def _reset_each(self):
+            """Reset every environment with its own options (one masked reset each)."""
+            obs = None
+            for i, opts in enumerate(self._options):
+                mask = np.arange(self.num_envs) == i
+                obs, info = self.venv.reset(seed=self._seeds,
+                                            options={**opts, "reset_mask": mask})
+                self.reset_infos[i] = env_infos(info, self.num_envs)[i]
             return obs
 
         def step_async(self, actions):
@@ -39,12 +98,14 @@ def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
             dones = term | trunc
             infos = [{} for _ in range(self.num_envs)]
             if dones.any():
+                started = env_infos(info, self.num_envs, prefix="reset_")
                 for i in np.flatnonzero(dones):
                     infos[i]["terminal_observation"] = info["final_obs"][i]
                     infos[i]["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
                     for key in ("termination", "failure", "truncation"):
                         if key in info and info["_" + key][i]:
                             infos[i][key] = info[key][i]
+                    self.reset_infos[i] = started[i]
             return obs, rew.astype(np.float32), dones, infos
 
         def close(self):

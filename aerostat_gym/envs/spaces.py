@@ -143,10 +143,37 @@ def scales() -> np.ndarray:
     return np.array([c.scale for c in CHANNELS])
 
 
-def as_batch(obs, dtype=np.float32) -> tuple[np.ndarray, bool]:
+def _channel_name(index: int, width: int) -> str:
+    """The name of entry ``index`` of an observation ``width`` channels wide: the standard
+    channel's, then (the full layout) the mean wind speed and the state deviation's entries;
+    a narrower vector is no layout of the task's, so its entries go by position."""
+    if width < N_OBS:
+        return f"channel {index}"
+    if index < N_OBS:
+        return CHANNELS[index].name
+    if index == OBS_FULL_WIND:
+        return "wind_speed"
+    return f"state[{index - OBS_FULL_STATE}]"
+
+
+def _refuse_non_finite(arr: np.ndarray) -> None:
+    """A ValueError naming the channels of ``arr`` (last axis) that hold NaN or infinities,
+    with the first such value of each and the batch rows they are in."""
+    bad = ~np.isfinite(arr.reshape(-1, arr.shape[-1]) if arr.ndim else arr.reshape(1, 1))
+    rows, cols = np.nonzero(bad)
+    flat = arr.reshape(bad.shape)
+    named = [f"{flat[rows[cols == c][0], c]} in {_channel_name(c, bad.shape[1])}"
+             for c in np.unique(cols)]
+    where = f" (batch rows {np.unique(rows).tolist()})" if arr.ndim > 1 else ""
+    raise ValueError(f"observations must be finite: got {', '.join(named)}{where}")
+
+
+def as_batch(obs, dtype=np.float32, episode_start=None) -> tuple[np.ndarray, bool]:
     """Observations as a 2-D batch of ``dtype``, and whether a single vector was given: the one
     door every policy's ``predict`` reads through. Anything that is not an array of real
-    numbers is a ValueError naming what was given (not numpy's conversion message)."""
+    numbers, or holds NaN or infinities, is a ValueError naming what was given (the channels
+    by name), raised before a policy touches its state; so is an ``episode_start`` (when given)
+    that does not hold one flag per observation of the batch."""
     try:
         arr = np.asarray(obs)
         ok = arr.dtype.kind in "biuf"
@@ -155,7 +182,27 @@ def as_batch(obs, dtype=np.float32) -> tuple[np.ndarray, bool]:
     if not ok:
         raise ValueError(f"observations must be an array of real numbers, got {obs!r:.80}")
     arr = arr.astype(dtype, copy=False)
-    return (arr[None, :], True) if arr.ndim == 1 else (arr, False)
+    if arr.dtype.kind == "f" and not np.isfinite(arr).all():
+        _refuse_non_finite(arr)
+    batch, single = (arr[None, :], True) if arr.ndim == 1 else (arr, False)
+    if episode_start is not None:
+        _check_episode_start(episode_start, len(batch) if batch.ndim else 1)
+    return batch, single
+
+
+def _check_episode_start(episode_start, n: int) -> None:
+    """``episode_start``: one boolean flag per observation of a batch of ``n``."""
+    try:
+        flags = np.asarray(episode_start)
+        ok = flags.dtype.kind in "biuf"  # RecurrentPPO keeps its flags as floats
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ValueError(f"episode_start must be flags (booleans), one per observation, got "
+                         f"{episode_start!r:.80}")
+    if flags.size != n:
+        raise ValueError(f"episode_start must hold one flag per observation of the batch ({n}), "
+                         f"got {flags.size}")
 
 
 def check_obs_noise(value, error: type[ValueError] = ValueError) -> float:

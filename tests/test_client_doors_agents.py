@@ -1,0 +1,334 @@
+"""The agents' and the CLI's doors: what a policy's ``predict``, ``load_policy``, the SB3
+adapter, ``train`` and ``evaluate`` refuse, and that they refuse it before touching state,
+building a model or writing a directory."""
+
+from __future__ import annotations
+
+import re
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from aerostat_gym.agents.policies import load_policy
+from aerostat_gym.agents.sb3io import PolicyError, SB3Policy, saved_algorithm
+from aerostat_gym.agents.train import TrainingError, check_hyperparams, load_hyperparams, train
+from aerostat_gym.cli import main
+from aerostat_gym.envs.sb3 import sb3_vec_env
+from aerostat_gym.envs.spaces import (
+    N_OBS,
+    OBS_DPITCH,
+    OBS_DZ,
+    OBS_FULL_STATE,
+    OBS_FULL_WIND,
+    OBS_VX,
+    as_batch,
+)
+from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
+from aerostat_gym.resources import shipped_root
+
+#: Policies that read the standard observation, and those that read the full one.
+STANDARD = ("passive", "tension", "lqg", "modal_lqg", "modal_lqg_shaped", "shipped")
+FULL = ("lqr", "modal")
+
+
+@pytest.fixture(scope="module")
+def observations():
+    """A standard and a full observation of the registered task at its first step (seed 0)."""
+    standard, _ = gym.make("TetheredAerostat-v0").reset(seed=0)
+    full, _ = gym.make("TetheredAerostat-v0", observation="full").reset(seed=0)
+    return standard, full
+
+
+class _Box(gym.Env):
+    """A bare space pair for building SB3 models that never step."""
+
+    action_space = gym.spaces.Box(-1, 1, (1,), np.float32)
+
+    def __init__(self, width: int):
+        self.observation_space = gym.spaces.Box(-1, 1, (width,), np.float32)
+
+
+# --- D6: observations and episode starts -------------------------------------------------------
+
+@pytest.mark.parametrize("name", STANDARD + FULL)
+def test_every_policy_refuses_a_non_finite_observation_naming_the_channel(name, observations):
+    """NaN in the along-wind velocity is named as vx (a standard channel), NaN in the full
+    layout's mean wind speed as wind_speed: a ValueError, not torch's or numpy's message."""
+    standard, full = observations
+    obs, index, channel = ((standard, OBS_VX, "vx") if name in STANDARD
+                           else (full, OBS_FULL_WIND, "wind_speed"))
+    bad = obs.copy()
+    bad[index] = np.nan
+    with pytest.raises(ValueError, match=f"^observations must be finite: got nan in {channel}$"):
+        load_policy(name).predict(bad, episode_start=np.array([True]))
+
+
+def test_non_finite_entries_are_named_by_channel_and_batch_row(observations):
+    """Two channels of the second row: each named with its value, the row given; the full
+    layout's state deviation by its index; a vector narrower than the standard one by
+    position."""
+    standard, full = observations
+    batch = np.stack([standard, standard])
+    batch[1, OBS_VX], batch[1, OBS_DPITCH] = np.inf, -np.inf
+    with pytest.raises(ValueError, match=re.escape(
+            "got inf in vx, -inf in dpitch (batch rows [1])")):
+        load_policy("shipped").predict(batch, episode_start=np.ones(2, bool))
+    wide = full.copy()
+    wide[OBS_FULL_STATE + 5] = np.inf
+    with pytest.raises(ValueError, match=re.escape("got inf in state[5]")):
+        as_batch(wide)
+    with pytest.raises(ValueError, match=re.escape("got nan in channel 2")):
+        as_batch([0.0, 1.0, np.nan])
+
+
+@pytest.mark.parametrize("name", ["shipped", "modal_lqg"])
+def test_a_refused_observation_leaves_the_policy_state_as_it_was(name, observations):
+    """The shipped policy (residual on modal_lqg: a Kalman filter, a command filter) and the
+    LQG: after an infinite velocity is refused, the next finite observation gives the same
+    action as on a run that never saw it (a poisoned state gave NaN for the next 3 steps)."""
+    standard, _ = observations
+    policy = load_policy(name)
+    start = np.array([True])
+    _, state = policy.predict(standard, None, start)
+    clean, _ = policy.predict(standard, state, np.array([False]))
+    poisoned = standard.copy()
+    poisoned[OBS_VX] = np.inf
+    with pytest.raises(ValueError, match="got inf in vx"):
+        policy.predict(poisoned, state, np.array([False]))
+    after, _ = policy.predict(standard, state, np.array([False]))
+    assert np.isfinite(after).all() and np.array_equal(after, clean)
+
+
+@pytest.mark.parametrize("name", ["passive", "tension", "lqr", "modal", "shipped", "lqg",
+                                  "modal_lqg", "modal_lqg_shaped"])
+def test_episode_start_of_another_length_is_refused(name, observations):
+    """Four observations with three start flags: named, not numpy's broadcast error (the
+    privileged controllers read the full observation)."""
+    standard, full = observations
+    obs = full if name in ("lqr", "modal") else standard
+    with pytest.raises(ValueError, match=re.escape(
+            "episode_start must hold one flag per observation of the batch (4), got 3")):
+        load_policy(name).predict(np.tile(obs, (4, 1)), episode_start=np.ones(3, bool))
+
+
+def test_frame_stack_policy_checks_at_the_door(observations):
+    """An SB3Policy with a two-frame stack: NaN and a short episode_start refused, then a
+    finite step acts (the stack untouched by the refusals)."""
+    from stable_baselines3 import PPO
+
+    standard, _ = observations
+    policy = SB3Policy(PPO("MlpPolicy", _Box(2 * N_OBS), n_steps=8, batch_size=8),
+                       frame_stack=2)
+    bad = standard.copy()
+    bad[OBS_DZ] = np.nan
+    with pytest.raises(ValueError, match="got nan in dz$"):
+        policy.predict(bad, episode_start=np.array([True]))
+    with pytest.raises(ValueError, match=re.escape("of the batch (2), got 1")):
+        policy.predict(np.stack([standard, standard]), episode_start=np.array([True]))
+    action, state = policy.predict(standard, episode_start=np.array([True]))
+    assert action.shape == (1,) and state["stack"].shape == (1, 2 * N_OBS)
+    assert np.array_equal(state["stack"][0, :N_OBS], np.zeros(N_OBS))
+
+
+@pytest.mark.parametrize("wind_range, needle", [
+    ("x", "wind_range must be a number or a (low, high) pair, got 'x'"),
+    ((0, 200), "wind_range must satisfy 0.0 <= low <= high <= 100 (finite), got (0, 200)"),
+    ((3, float("nan")), "wind_range must satisfy 0.0 <= low <= high <= 100 (finite)"),
+    ((1, 2, 3), "wind_range must be a number or a (low, high) pair, got (1, 2, 3)"),
+])
+def test_load_policy_refuses_a_bad_wind_range(wind_range, needle):
+    with pytest.raises(PolicyError, match=re.escape(needle)):
+        load_policy("lqr", wind_range=wind_range)
+
+
+def test_load_policy_reads_a_single_wind_speed_as_the_task_does():
+    """wind_range=5 is the fixed speed (5, 5), as the task's wind_speed=5: the LQR schedule
+    covers it with one design step of margin each side."""
+    assert load_policy("lqr", wind_range=5).schedule.speeds.tolist() == [4.0, 5.0, 6.0]
+
+
+# --- D8: the SB3 adapter -----------------------------------------------------------------------
+
+def test_sb3_adapter_passes_set_options_to_the_next_reset_only():
+    """As DummyVecEnv: set_options applies at the next reset (one dict for all, or one per
+    environment), then is cleared; reset_infos holds each environment's reset info, also after
+    a same-step automatic reset."""
+    venv = sb3_vec_env(2, seed=0, max_episode_steps=2)
+    venv.set_options({"wind_speed": 5.0})
+    venv.reset()
+    assert [ep.wind_speed for ep in venv.venv.batch.episodes] == [5.0, 5.0]
+    assert [info["wind_speed"] for info in venv.reset_infos] == [5.0, 5.0]
+    assert venv._options == [{}, {}]
+    venv.set_options([{"wind_speed": 12.0}, {}])
+    venv.reset()
+    assert venv.venv.batch.episodes[0].wind_speed == 12.0
+    assert venv.reset_infos[0]["wind_speed"] == 12.0
+    for _ in range(2):
+        *_, dones, _ = venv.step(np.zeros((2, 1), np.float32))
+    assert dones.tolist() == [True, True]
+    assert [info["wind_speed"] for info in venv.reset_infos] == [
+        ep.wind_speed for ep in venv.venv.batch.episodes]
+
+
+def test_sb3_adapter_seeds_as_the_native_batch():
+    """Without options, a seeded reset is the native batch's reset(seed=[0, 1])."""
+    venv = sb3_vec_env(2, seed=0)
+    venv.reset()
+    native = TetheredAerostatVectorEnv(2)
+    _, info = native.reset(seed=[0, 1])
+    assert [ep.wind_speed for ep in venv.venv.batch.episodes] == info["wind_speed"].tolist()
+    assert [i["wind_speed"] for i in venv.reset_infos] == info["wind_speed"].tolist()
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, True])
+def test_sb3_adapter_refuses_a_bad_seed_when_made(seed):
+    with pytest.raises(ValueError, match=re.escape(
+            f"seed must be None or an integer >= 0, got {seed!r}")):
+        sb3_vec_env(2, seed=seed)
+
+
+def test_sb3_adapter_refuses_options_that_are_not_one_per_environment():
+    venv = sb3_vec_env(2)
+    with pytest.raises(ValueError, match=re.escape(
+            "set_options takes a dict of reset options or a list of 2 (one per environment), "
+            "got [{}]")):
+        venv.set_options([{}])
+
+
+# --- D9, D11: the checkpoint to resume ---------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def checkpoints(tmp_path_factory):
+    """Untrained models of each algorithm, saved: their policy class is what names them."""
+    from sb3_contrib import RecurrentPPO
+    from stable_baselines3 import PPO, SAC, TD3
+
+    folder = tmp_path_factory.mktemp("checkpoints")
+    out = {}
+    for Algo, policy in ((PPO, "MlpPolicy"), (SAC, "MlpPolicy"), (TD3, "MlpPolicy"),
+                         (RecurrentPPO, "MlpLstmPolicy")):
+        path = folder / f"{Algo.__name__}.zip"
+        Algo(policy, _Box(N_OBS)).save(path)
+        out[Algo.__name__] = path
+    return out
+
+
+def test_saved_algorithm_is_read_from_the_policy_class(checkpoints):
+    """RecurrentPPO's LSTM policy is an actor-critic too: the most derived match names it."""
+    assert {name: saved_algorithm(path) for name, path in checkpoints.items()} == {
+        "PPO": "PPO", "SAC": "SAC", "TD3": "TD3", "RecurrentPPO": "RecurrentPPO"}
+
+
+def test_resuming_a_checkpoint_of_another_algorithm_is_refused(tmp_path, checkpoints, capsys):
+    """A PPO checkpoint resumed as SAC: one line naming both, exit 2, no run directory."""
+    run = tmp_path / "run"
+    needle = (f"the checkpoint to resume {checkpoints['PPO']} is a PPO model, but the algorithm "
+              "is sac (SAC): resume it with --algo ppo")
+    with pytest.raises(TrainingError, match=re.escape(needle)):
+        train("sac", resume=checkpoints["PPO"], timesteps=512, n_envs=2, run_dir=run,
+              progress_bar=False)
+    assert main(["train", "--algo", "sac", "--resume", str(checkpoints["PPO"]), "--timesteps",
+                 "512", "--n-envs", "2", "--run-dir", str(run), "--no-progress"]) == 2
+    assert capsys.readouterr().err == f"aerostat-gym train: error: {needle}\n"
+    assert not run.exists()
+
+
+@pytest.mark.parametrize("content, needle", [
+    (None, "checkpoint to resume not found: {path}"),
+    (b"not a zip", "checkpoint to resume {path} is not a Stable-Baselines3 model (.zip archive)"),
+])
+def test_a_bad_checkpoint_is_named_before_the_run_directory(tmp_path, content, needle, capsys):
+    path = tmp_path / "bad.zip"
+    if content is not None:
+        path.write_bytes(content)
+    run = tmp_path / "run"
+    assert main(["train", "--resume", str(path), "--timesteps", "512", "--n-envs", "2",
+                 "--run-dir", str(run), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("aerostat-gym train: error: " + needle.format(path=path))
+    assert err.count("\n") == 1 and "hyperparameters" not in err
+    assert not run.exists()
+
+
+# --- D10: hyperparameter values ----------------------------------------------------------------
+
+BLOCK = "TetheredAerostat-v0:\n  n_envs: 1\n  n_steps: 32\n  batch_size: 32\n"
+
+
+@pytest.mark.parametrize("extra, needle", [
+    ('  normalize: "dict(bogus=1)"\n', "normalize: unknown VecNormalize argument(s) ['bogus']; "
+                                       "it takes ['clip_obs', "),
+    ('  normalize: "dict(norm_obs=True, epsilon=-1.0)"\n',
+     "normalize's epsilon must be a finite number > 0, got -1.0"),
+    ("  ent_coef: .nan\n", "ent_coef must be a finite number >= 0, got nan"),
+    ("  gamma: 1.5\n", "gamma must be a discount in (0, 1], got 1.5"),
+    ("  gae_lambda: 0\n", "gae_lambda must be a number in (0, 1], got 0"),
+    ("  vf_coef: -1\n", "vf_coef must be a finite number >= 0, got -1"),
+    ("  learning_rate: lin_3e-4\n", "learning_rate must be a finite number > 0, got 'lin_3e-4'"),
+    ("  n_epochs: 2.5\n", "n_epochs must be an integer >= 1, got 2.5"),
+])
+def test_a_hyperparameter_out_of_range_is_named(tmp_path, extra, needle, capsys):
+    """One line naming the key and the value, exit 2, before a model or a run directory."""
+    path = tmp_path / "hp.yml"
+    path.write_text(BLOCK + extra)
+    run = tmp_path / "run"
+    assert main(["train", "--hyperparams", str(path), "--timesteps", "512", "--run-dir",
+                 str(run), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("aerostat-gym train: error: PPO refuses the hyperparameters: " + needle)
+    assert err.count("\n") == 1 and not run.exists()
+
+
+@pytest.mark.parametrize("value, accepted", [
+    ("auto", True), ("auto_0.1", True), (0.05, True), (0.0, True), ("auto_0", False),
+    ("auto_x", False), (-0.1, False), (float("inf"), False)])
+def test_sac_entropy_weight_is_learned_or_fixed(value, accepted):
+    hp = {"ent_coef": value}
+    if accepted:
+        assert check_hyperparams("sac", hp) is None
+    else:
+        with pytest.raises(TrainingError, match=re.escape(
+                f"SAC refuses the hyperparameters: ent_coef must be 'auto', 'auto_X' (X > 0) "
+                f"or a finite number >= 0, got {value!r}")):
+            check_hyperparams("sac", hp)
+
+
+def test_a_key_the_algorithm_does_not_take_is_left_to_it():
+    """tau is SAC's and TD3's: in a PPO block SB3 names it (unexpected keyword), so the
+    range check does not; TD3's noise_std (not a constructor argument) is checked."""
+    assert check_hyperparams("ppo", {"tau": 5.0}) is None
+    with pytest.raises(TrainingError, match=re.escape("tau must be a soft-update rate in (0, 1]")):
+        check_hyperparams("sac", {"tau": 5.0})
+    with pytest.raises(TrainingError, match=re.escape("noise_std must be a finite number >= 0")):
+        check_hyperparams("td3", {"noise_std": -0.1})
+
+
+def test_every_shipped_hyperparameter_file_passes_the_checks():
+    """The shipped training files (14; ppo_space.yml is tune's search space) are in range;
+    their normalize blocks parse to VecNormalize's."""
+    files = sorted(p for p in (shipped_root() / "hyperparams").glob("*.yml")
+                   if not p.stem.endswith("_space"))
+    assert len(files) == 14
+    for path in files:
+        algo = path.stem.split("_")[0]
+        _, hp, _ = load_hyperparams(algo, path)
+        norm = check_hyperparams(algo, hp)
+        assert norm["norm_obs"] is True and 0 < norm["gamma"] <= 1
+
+
+# --- D12: the report directory -----------------------------------------------------------------
+
+def test_evaluate_checks_its_output_directory_before_evaluating(tmp_path, monkeypatch, capsys):
+    """--out under a file: one line, exit 2, and no episode run."""
+    import aerostat_gym.cli.agents as cli_agents
+
+    ran = []
+    monkeypatch.setattr(cli_agents, "run_evaluations", lambda *a, **k: ran.append(a))
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    out = blocker / "report"
+    assert main(["evaluate", "--policy", "passive", "--speeds", "10", "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (f"aerostat-gym evaluate: error: --out {out}: cannot "
+                                       "write there (Not a directory)\n")
+    assert ran == []
