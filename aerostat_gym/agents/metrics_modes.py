@@ -23,7 +23,7 @@ import math
 import numpy as np
 from scipy.optimize import least_squares
 
-from .metrics import DampedFit, _failed
+from .metrics import DampedFit, _failed, mode_fit
 
 
 def _rates(zeta: float, period: float) -> tuple[float, float]:
@@ -65,7 +65,8 @@ def fit_modes(t, y, starts) -> list[DampedFit]:
         def resid(x):
             return (basis(x[n_lin:]) @ x[:n_lin] - y) / span
 
-        wmax = math.pi / float(np.median(np.diff(tt)))
+        dt = float(np.median(np.diff(tt)))
+        wmax = math.pi / dt
         lo = np.array([-np.inf] * n_lin + [-1.0, 1e-9] * k_modes)
         hi = np.array([np.inf] * n_lin + [10 * wmax, wmax] * k_modes)
         x0 = np.clip(np.concatenate([coef, q0]), lo + 1e-12, hi - 1e-12)
@@ -78,11 +79,7 @@ def fit_modes(t, y, starts) -> list[DampedFit]:
         for k in range(k_modes):
             a, b = sol.x[1 + 2 * k], sol.x[2 + 2 * k]
             sg, wd = sol.x[n_lin + 2 * k], sol.x[n_lin + 2 * k + 1]
-            wn = math.hypot(sg, wd)
-            out.append(DampedFit(zeta=float(sg / wn), period=float(2 * math.pi / wn),
-                                 amplitude=float(math.hypot(a, b)), offset=float(sol.x[0]),
-                                 r2=float(r2), damped_period=float(2 * math.pi / wd),
-                                 phase=float(math.atan2(-b, a))))
+            out.append(mode_fit(a, b, sg, wd, sol.x[0], r2, dt))
         return out
     except Exception as exc:  # noqa: BLE001 - a metric must never abort an evaluation
         return [_failed(f"fit failed: {type(exc).__name__}: {exc}")] * k_modes

@@ -265,7 +265,8 @@ def figure9_data(sweep: Sweep, modes: dict | None = None) -> dict:
 
     Period is 2 pi / omega_n; where a tracked mode is a real (non-oscillatory) eigenvalue, as
     the neutral yaw mode at zero wind, period and damping are reported as null (the full modal
-    table, :meth:`Sweep.rows`, keeps them).
+    table, :meth:`Sweep.rows`, keeps its damping ratio, +1 or -1, and its eigenvalue; a real
+    eigenvalue has no period there either).
     """
     modes = modes or FIGURE9_MODES
     out = {"wind_speed_m_s": sweep.values.tolist(), "all_stable": sweep.all_stable(),
@@ -306,32 +307,96 @@ def figure9_rows(data: dict) -> list[dict]:
     return rows
 
 
-def plot_figure9(data: dict, path: str | Path, title: str = "") -> Path:
-    """[LN02] Figure 9 layout: longitudinal (left) and lateral (right) modes, period on top,
-    damping ratio below, against wind speed."""
+#: [LN02] Figure 9's period axes [s], kept while the curves fit in them (the baseline's do), so
+#: the figure reads against the paper's; a larger aerostat's slower modes widen them.
+FIGURE9_PERIOD_TOP = {"long": 50.0, "lat": 100.0}
+#: [LN02] Figure 9's damping-ratio axis, widened only by data outside it (an unstable mode).
+FIGURE9_DAMPING_RANGE = (0.0, 1.0)
+#: Modes the period axis does not stretch for: the yaw mode, this model's addition to [LN02]'s
+#: figure, is a weathervane whose aerodynamic stiffness grows as U^2, so its period diverges as
+#: the wind drops (baseline: 184 s at 0.5 m/s, 4 s at 20 m/s). Its lowest-speed point would set
+#: the axis by the sweep's step alone; where it runs above the axis its legend names its top.
+FIGURE9_UNSCALED_MODES = {"long": (), "lat": ("yaw",)}
+
+
+def _nice_ceiling(x: float) -> float:
+    """The smallest of 1, 2, 2.5, 5 x 10^k at or above x > 0 (a round axis end)."""
+    decade = 10.0 ** math.floor(math.log10(x))
+    return next(decade * m for m in (1.0, 2.0, 2.5, 5.0, 10.0) if decade * m >= x * (1 - 1e-12))
+
+
+def _finite(curves) -> np.ndarray:
+    """Every finite value of a collection of curves (None and NaN dropped)."""
+    flat = [v for curve in curves for v in curve if v is not None]
+    values = np.asarray(flat, float)
+    return values[np.isfinite(values)]
+
+
+def period_limits(curves, paper_top: float) -> tuple[float, float]:
+    """(0, top) of a period axis: the paper's top while every period fits under it, else a
+    round top 5 % above the longest period (a 35 m hull's 84-163 s pendulums)."""
+    values = _finite(curves)
+    longest = float(values.max()) if values.size else 0.0
+    return 0.0, paper_top if longest <= paper_top else _nice_ceiling(1.05 * longest)
+
+
+def damping_limits(curves) -> tuple[float, float]:
+    """(bottom, top) of a damping-ratio axis: [LN02]'s 0 to 1, widened to a round end 5 %
+    beyond the data that lie outside it (a negative ratio is an unstable mode; 0 stays in)."""
+    values = _finite(curves)
+    low, high = FIGURE9_DAMPING_RANGE
+    if values.size and values.min() < low:
+        low = -_nice_ceiling(-1.05 * float(values.min()))
+    if values.size and values.max() > high:
+        high = _nice_ceiling(1.05 * float(values.max()))
+    return low, high
+
+
+def _legend_label(label: str, periods: np.ndarray, top: float) -> str:
+    """A curve's legend entry, naming its longest period where that runs above the axis."""
+    longest = float(np.nanmax(periods)) if np.any(np.isfinite(periods)) else 0.0
+    return label if longest <= top else f"{label} (to {longest:.0f} s, off scale)"
+
+
+def figure9_axes(data: dict, title: str = ""):
+    """The Figure 9 plot of :func:`plot_figure9` as (figure, 2 x 2 axes), not yet saved."""
     plt = _pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True)
     u = np.array(data["wind_speed_m_s"], float)
     styles = ["-", "--", "-.", ":", (0, (5, 1, 1, 1))]
     colours = ["k", "tab:blue", "tab:red", "tab:green", "tab:purple"]
     for col, (subset, name) in enumerate((("long", "Longitudinal"), ("lat", "Lateral"))):
+        period_axis = period_limits([c["period_s"] for label, c in data[subset].items()
+                                     if label not in FIGURE9_UNSCALED_MODES[subset]],
+                                    FIGURE9_PERIOD_TOP[subset])
         for k, (label, curves) in enumerate(data[subset].items()):
             per = np.array([np.nan if v is None else v for v in curves["period_s"]])
             zeta = np.array([np.nan if v is None else v for v in curves["zeta"]])
-            kw = {"color": colours[k % 5], "ls": styles[k % 5], "label": label}
+            kw = {"color": colours[k % 5], "ls": styles[k % 5],
+                  "label": _legend_label(label, per, period_axis[1])}
             axes[0, col].plot(u, per, **kw)
             axes[1, col].plot(u, zeta, **kw)
         axes[0, col].set_title(f"{name} Modes")
         axes[0, col].set_ylabel(r"period, $\tau_n$ (s)")
         axes[1, col].set_ylabel(r"damping ratio, $\zeta$")
         axes[1, col].set_xlabel("U (m/s)")
-        axes[0, col].set_ylim(0, 50 if subset == "long" else 100)
-        axes[1, col].set_ylim(0, 1)
+        axes[0, col].set_ylim(*period_axis)
+        axes[1, col].set_ylim(*damping_limits([c["zeta"] for c in data[subset].values()]))
         axes[0, col].legend(fontsize=8)
         for ax in axes[:, col]:
             ax.grid(alpha=0.3)
     fig.suptitle(title or "Longitudinal and lateral modes (cf. [LN02] Fig. 9)")
     fig.tight_layout()
+    return fig, axes
+
+
+def plot_figure9(data: dict, path: str | Path, title: str = "") -> Path:
+    """[LN02] Figure 9 layout: longitudinal (left) and lateral (right) modes, period on top,
+    damping ratio below, against wind speed; the paper's axis ranges unless the data leave
+    them (:func:`period_limits`, :func:`damping_limits`; the yaw mode's low-wind end is not
+    scaled for, :data:`FIGURE9_UNSCALED_MODES`)."""
+    plt = _pyplot()
+    fig, _ = figure9_axes(data, title)
     path = Path(path)
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -437,7 +502,8 @@ def plot_family(fam: dict, name: str, path: str | Path) -> Path:
         axes[1, col].set_ylabel(r"damping ratio, $\zeta$")
         axes[1, col].set_xlabel("U (m/s)")
         axes[0, col].set_yscale("log")
-        axes[1, col].set_ylim(0, 1)
+        axes[1, col].set_ylim(*damping_limits([c["zeta"] for data in fam.values()
+                                               for c in data[SETS[col]].values()]))
         axes[0, col].legend(fontsize=6, ncol=2)
     fig.tight_layout()
     path = Path(path)

@@ -51,7 +51,7 @@ class Mode:
     ----------
     eigenvalue : lambda (Im >= 0 for a complex pair). vector : eigenvector in the subset's state
     order. wn : natural frequency |lambda| [rad/s]. zeta : -Re(lambda)/|lambda|. period : 2 pi / wn
-    [s]. oscillatory : Im(lambda) != 0. stable : Re(lambda) < 0 or neutral. neutral : |lambda| <
+    [s] (as ``control.damp``; no period for a real eigenvalue: :meth:`natural_period`). oscillatory : Im(lambda) != 0. stable : Re(lambda) < 0 or neutral. neutral : |lambda| <
     :data:`NEUTRAL_RATE`. label : classification. energy : kinetic-energy share per state group.
     shape : real-ified transverse tether shape, anchor (0) to confluence point.
     sign_changes : sign changes of the shape along the moving nodes.
@@ -70,11 +70,27 @@ class Mode:
     shape: np.ndarray | None = None
     sign_changes: int = 0
 
+    def natural_period(self) -> float | None:
+        """2 pi / omega_n [s] of an oscillatory mode; None for a real eigenvalue, which decays
+        or grows without swinging (its 2 pi / |lambda| is no period)."""
+        return self.period if self.oscillatory and math.isfinite(self.period) else None
+
+    def describe(self) -> str:
+        """One-line text of the mode's timing: "period P s  damping Z" for an oscillatory
+        mode; for a real eigenvalue, "real (non-oscillatory), time constant 1/|lambda| s"
+        with whether it decays or grows (zeta = +1 or -1 carries no more than that)."""
+        if self.oscillatory:
+            return f"period {self.period:7.2f} s  damping {self.zeta:.3f}"
+        if self.neutral:
+            return "real (non-oscillatory), neutral"
+        trend = "decays" if self.eigenvalue.real < 0 else "GROWS"
+        return f"real (non-oscillatory), {trend} with time constant {1.0 / self.wn:.3g} s"
+
     def row(self) -> dict:
         """Plain-number summary (for tables and JSON)."""
         return {"label": self.label, "eigenvalue_re": float(self.eigenvalue.real),
                 "eigenvalue_im": float(self.eigenvalue.imag), "wn_rad_s": self.wn,
-                "zeta": self.zeta, "period_s": self.period if math.isfinite(self.period) else None,
+                "zeta": self.zeta, "period_s": self.natural_period(),
                 "oscillatory": self.oscillatory,
                 "stable": self.stable, "neutral": self.neutral,
                 "energy": {k: round(v, 4) for k, v in self.energy.items()}}
@@ -443,6 +459,22 @@ class Sweep:
 
     def all_stable(self) -> bool:
         return all(a.all_stable() for a in self.analyses)
+
+    def unstable(self) -> list[dict]:
+        """The tracked modes that are unstable at one or more swept values, whether or not a
+        table shows their track: per track its set, label, the values where it is unstable
+        and, at the one where it grows fastest (largest Re(lambda)), that mode. Empty exactly
+        when :meth:`all_stable` (every mode of every analysis lies on one track)."""
+        out = []
+        for subset in SETS:
+            for label, track in self.tracks[subset]:
+                bad = [(float(v), m) for v, m in zip(self.values, track, strict=True)
+                       if m is not None and not m.stable]
+                if bad:
+                    value, worst = max(bad, key=lambda item: item[1].eigenvalue.real)
+                    out.append({"set": subset, "label": label, "values": [v for v, _ in bad],
+                                "worst_value": value, "worst": worst})
+        return out
 
     def rows(self) -> list[dict]:
         """One row per (value, set, tracked mode): label, period, damping, stability."""

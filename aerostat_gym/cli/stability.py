@@ -98,7 +98,42 @@ def _stability_text(sweep, dec_ratios: list[dict]) -> str:
                  f"{worst_ul:.1e}, lower left <= {worst_ll:.1e}")
     lines.append(f"all modes stable at every speed: {sweep.all_stable()}   "
                  f"({len(sweep.values)} speeds, trims included, in {sweep.seconds:.2f} s)")
+    lines += [_unstable_line(u) for u in sweep.unstable()]
     return "\n".join(lines)
+
+
+#: Up to this many speeds an unstable mode's speeds are listed one by one, beyond it as a range.
+LISTED_SPEEDS = 6
+
+
+def _speeds_text(speeds: list[float]) -> str:
+    if len(speeds) <= LISTED_SPEEDS:
+        return ", ".join(f"{u:g}" for u in speeds) + " m/s"
+    return f"{speeds[0]:g}-{speeds[-1]:g} m/s ({len(speeds)} speeds)"
+
+
+def _eigenvalue_text(lam: complex) -> str:
+    """lambda [1/s] of a mode: one real number, or the pair Re +/- Im j."""
+    return f"{lam.real:+.4g}" if lam.imag == 0 else f"{lam.real:+.4g} +/- {lam.imag:.4g}j"
+
+
+def _unstable_line(entry: dict) -> str:
+    """An unstable mode of :meth:`Sweep.unstable` named under the table, whether or not the
+    table has its column (a divergent real eigenvalue beside the lateral pendulum has none):
+    where it is unstable and its eigenvalue where it grows fastest."""
+    worst = entry["worst"]
+    subset = {"long": "longitudinal", "lat": "lateral"}[entry["set"]]
+    return (f"  UNSTABLE {subset} {entry['label']} at U = {_speeds_text(entry['values'])}; "
+            f"fastest at {entry['worst_value']:g} m/s: lambda = "
+            f"{_eigenvalue_text(worst.eigenvalue)} 1/s, {worst.describe().strip()}")
+
+
+def _unstable_json(sweep) -> list[dict]:
+    """:meth:`Sweep.unstable` as JSON: the fastest-growing point's modal row under the track's
+    label (e.g. "pendulum (2)", the one the full modal table uses)."""
+    return [{**u["worst"].row(), "set": u["set"], "label": u["label"],
+             "wind_speeds_m_s": u["values"], "worst_wind_speed_m_s": u["worst_value"]}
+            for u in sweep.unstable()]
 
 
 def held_speeds(params, speeds: np.ndarray) -> np.ndarray:
@@ -142,6 +177,7 @@ def cmd_stability(args) -> int:
     if args.json:
         out = {"tether_length_m": params.tether.length, "n_elements": params.tether.n_elements,
                "all_stable": sweep.all_stable(), "seconds": sweep.seconds,
+               "unstable_modes": _unstable_json(sweep),
                "coupling_ratios": ratios, "figure9": figure9_data(sweep),
                "modes": sweep.rows()}
         print(json.dumps(out, indent=1, default=_json_default))
