@@ -37,7 +37,13 @@ from aerostat_gym.scale.montecarlo import (
 )
 from aerostat_gym.scale.ranges import ParameterRange, estimated_ranges, range_disagreements
 from aerostat_gym.scale.stats import point_biserial, wilson_interval
-from aerostat_gym.scale.tune import TuneSpaceError, apply_sample, config_table, load_space
+from aerostat_gym.scale.tune import (
+    TuneSpaceError,
+    apply_sample,
+    config_table,
+    load_space,
+    tune_space,
+)
 
 BASE = load_params()
 FAST_SPEEDS = (1.0, 2.0, 10.0)  # [m/s] a short sweep: the low-wind lateral pendulum and 10 m/s
@@ -333,6 +339,22 @@ def test_search_space_parsing(tmp_path):
     path.write_text("TetheredAerostat-v0:\n  gamma: {uniform: [0.99, 0.9]}\n")
     with pytest.raises(TuneSpaceError, match="'gamma' uniform needs"):
         load_space(path, "TetheredAerostat-v0")
+
+
+def test_a_whole_quniform_grid_samples_integers(tmp_path):
+    """quniform over whole numbers (a count such as n_steps, which the training refuses as a
+    float) samples integers on the grid, both ends included; a fractional grid stays float."""
+    from ray import tune
+
+    path = tmp_path / "space.yml"
+    path.write_text("TetheredAerostat-v0:\n  n_steps: {quniform: [64, 256, 64]}\n"
+                    "  gamma: {quniform: [0.9, 0.99, 0.01]}\n")
+    space, _ = tune_space(load_space(path, "TetheredAerostat-v0"), tune)
+    rng = np.random.default_rng(0)
+    draws = [space["n_steps"].sample(random_state=rng) for _ in range(200)]
+    assert all(isinstance(v, (int, np.integer)) for v in draws)
+    assert set(int(v) for v in draws) == {64, 128, 192, 256}
+    assert isinstance(space["gamma"].sample(random_state=rng), float)
 
 
 def test_config_table_mean_and_bootstrap_ci():

@@ -38,6 +38,7 @@ import numpy as np
 from ..agents.protocol_stats import bootstrap_mean_ci
 from ..agents.sb3io import vecnormalize_path
 from ..agents.train import PROJECT_BLOCK, train
+from ..checks import is_whole
 from .cluster import start_ray, stop_ray
 from .extra import require
 
@@ -132,6 +133,10 @@ def tune_space(space: dict, tune) -> tuple[dict, dict]:
             out[key] = tune.choice(args)
         elif kind == "randint":
             out[key] = tune.randint(int(args[0]), int(args[1]) + 1)  # inclusive high
+        elif kind == "quniform" and all(is_whole(a, 0) for a in args):
+            # a grid of whole numbers (n_steps, batch_size: counts the training refuses as
+            # floats) samples integers, upper end inclusive like quniform's
+            out[key] = tune.qrandint(*args)
         else:
             out[key] = getattr(tune, kind)(*args)
     return out, decode
