@@ -1105,7 +1105,10 @@ class Derived:
         xb, _, zb = a.cb_position
         zl = a.leash_z
         x_l = (B * (xb + zb * math.tan(th)) - F_lz * zl * math.tan(th)) / F_lz if F_lz > 0 else float("nan")
-        area = math.pi * t.diameter**2 / 4.0
+        try:
+            area = math.pi * t.diameter**2 / 4.0
+        except OverflowError:  # a diameter past 1e154 m: the cross checks refuse its weight
+            area = math.inf
         mu = t.density * area
         l_u = t.length / t.n_elements
         EA = t.youngs_modulus * area

@@ -212,6 +212,22 @@ def test_bad_perturbations_are_refused_as_reset_options(spec, message):
         env.reset(seed=0, options={"perturbation": spec})
 
 
+def test_a_gust_on_the_top_mean_wind_stays_below_the_wind_cap():
+    """The gust adds to the mean wind: a 60 m/s gust on winds up to 45 m/s (105 m/s) is refused
+    at make and as a reset option on a 3-15 m/s task with 90 m/s gusts; 85 m/s gusts on 15 m/s
+    (100 m/s) and any gust that never blows (probability 0) pass."""
+    gust = {"gust_probability": 1.0, "gust_amplitude": (1.0, 60.0)}
+    with pytest.raises(TaskError, match=r"up to 60 m/s on a mean wind_speed up to 45 m/s "
+                                        r"reaches 105 m/s, above 100 m/s"):
+        TetheredAerostatEnv(turbulence="none", wind_speed=(3.0, 45.0), perturbation=gust)
+    env = TetheredAerostatEnv(turbulence="none", wind_speed=(3.0, 15.0),
+                              perturbation={**gust, "gust_amplitude": (1.0, 85.0)})
+    with pytest.raises(TaskError, match=r"reaches 105 m/s"):
+        env.reset(seed=0, options={"perturbation": {**gust, "gust_amplitude": (1.0, 90.0)}})
+    TetheredAerostatEnv(turbulence="none", wind_speed=(3.0, 45.0),
+                        perturbation={**gust, "gust_probability": 0.0})
+
+
 def test_the_swing_bound_follows_the_configured_tether():
     with pytest.raises(TaskError, match=r"\|swing\| <= 150 m"):
         TetheredAerostatEnv(perturbation={"swing": 151.0}, tether_length=150.0, **SMALL)

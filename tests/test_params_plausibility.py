@@ -323,3 +323,10 @@ def test_a_comfortable_margin_keeps_the_plain_message():
         find_equilibrium(BASE, 10.0, tol=1e-30)
     assert "net lift" not in str(err.value)
     assert math.isfinite(BASE.derived.net_lift)
+
+
+def test_a_tether_diameter_whose_area_overflows_is_named():
+    """A diameter of 1e200 m squares past the largest float: the loader refuses the tether's
+    infinite weight naming tether.diameter (was Python's OverflowError from the derived area)."""
+    with pytest.raises(ParameterError, match=r"inf N, tether\.diameter"):
+        load_params(overrides={"tether.diameter": 1e200})

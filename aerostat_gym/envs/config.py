@@ -145,6 +145,7 @@ class TaskConfig:
             raise TaskError(f"wind_bank_seed must be an integer >= 0, got {self.wind_bank_seed!r}")
         r["params"] = self._params()
         r["perturbation"] = perturbation(self.perturbation, r["params"].tether.length)
+        check_gust_on_wind(r["perturbation"], r["wind_speed"][1])
         try:  # the field's heights and extent follow the configured aerostat, tether and winch
             r["turbulence"] = sized_turbulence(r["params"], self.turbulence)
         except (TypeError, ValueError) as exc:
@@ -339,6 +340,16 @@ def _check_displacements(out: dict, tether_length: float | None) -> None:
                    "pi/2 (the nose vertical, where the Euler kinematics are singular)")
             raise TaskError(f"perturbation {k} = {v!r} {units[k]} exceeds {why}: |{k}| <= "
                             f"{top:g} {units[k]}")
+
+
+def check_gust_on_wind(pert: dict, top_speed: float) -> None:
+    """The largest gust on the largest mean wind stays within MAX_WIND_SPEED: the gust adds to
+    the mean wind, and the model's incompressible aerodynamics end there."""
+    gust = pert["gust_amplitude"][1] if pert["gust_probability"] > 0 else 0.0
+    if gust + top_speed > MAX_WIND_SPEED:
+        raise TaskError(f"perturbation gust_amplitude up to {gust:g} m/s on a mean wind_speed up "
+                        f"to {top_speed:g} m/s reaches {gust + top_speed:g} m/s, above "
+                        f"{MAX_WIND_SPEED:g} m/s, where the incompressible aerodynamics end")
 
 
 def _check_gust(out: dict) -> None:

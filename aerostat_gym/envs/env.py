@@ -272,7 +272,7 @@ class TetheredAerostatEnv(gym.Env):
       it too (an AttributeError), and every call but ``close()`` after ``close()`` raises
       ``gymnasium.error.ClosedEnvironmentError`` (ran on in calm air); the perturbation's
       fields are bounded (swing and lateral by the tether length, pitch by pi/2, gust
-      amplitude by 100 m/s, duration in (0, 3600] s, onset by 86400 s) and a turbulence bank
+      amplitude plus the top mean wind by 100 m/s, duration in (0, 3600] s, onset by 86400 s) and a turbulence bank
       above 4 GiB (``aerostat_gym.wind.synthesis.MAX_FIELD_BYTES``) is a ``TaskError`` at make
       (was a NumPy MemoryError); the native vector env's infos are ``SyncVectorEnv``'s (plain
       reset keys, ``final_info``, ``time``; no ``truncation`` reason at a time limit). With
