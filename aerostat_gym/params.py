@@ -745,9 +745,9 @@ def check_plausibility(p: Params) -> None:
     dt, advised = p.simulation.semi_implicit_dt, advised_semi_implicit_dt(p)
     if dt > SEMI_IMPLICIT_REFUSE_FACTOR * advised:
         raise ImplausibleParameterError(
-            f"simulation.semi_implicit_dt = {dt:g} s is more than {SEMI_IMPLICIT_REFUSE_FACTOR:g} x "
-            f"the {advised:.3g} s advised for this aerostat (params.advised_semi_implicit_dt), past "
-            "the measured edge where the step fails (1.2-1.5 x): an unstable step can load the "
+            f"simulation.semi_implicit_dt = {dt:g} s is more than "
+            f"{SEMI_IMPLICIT_REFUSE_FACTOR:g} x the {advised:.3g} s advised for this aerostat "
+            "(params.advised_semi_implicit_dt), past the measured edge where the step fails (1.2-1.5 x): an unstable step can load the "
             "tether past its strength, and such a break could not be told from a real one. Set "
             f"simulation.semi_implicit_dt <= {advised:.3g} (a step up to "
             f"{SEMI_IMPLICIT_REFUSE_FACTOR:g} x loads with a warning)")

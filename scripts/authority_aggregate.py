@@ -85,7 +85,8 @@ def main(argv=None) -> dict:
             "# The aggregate with the privileged full state\n\n`PYTHONPATH=. python "
             "scripts/authority_aggregate.py <baselines' report.json>`: every authority-sweep "
             "design on every report cell (20 seeds, the report's turbulence and noise; the "
-            f"designs read the noise-free state, a tension relief the noisy load cell), {wall:.0f} s"
+            "designs read the noise-free state, a tension relief the noisy load cell), "
+            f"{wall:.0f} s"
             + (f" ({cached} designs' episodes read from the --episodes cache)" if cached else "")
             + ". The default `modal` and `lqr` "
             "designs are the baselines of those names. P(> X): probability that the design "

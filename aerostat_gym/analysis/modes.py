@@ -51,7 +51,8 @@ class Mode:
     ----------
     eigenvalue : lambda (Im >= 0 for a complex pair). vector : eigenvector in the subset's state
     order. wn : natural frequency |lambda| [rad/s]. zeta : -Re(lambda)/|lambda|. period : 2 pi / wn
-    [s] (as ``control.damp``; no period for a real eigenvalue: :meth:`natural_period`). oscillatory : Im(lambda) != 0. stable : Re(lambda) < 0 or neutral. neutral : |lambda| <
+    [s] (as ``control.damp``; no period for a real eigenvalue: :meth:`natural_period`).
+    oscillatory : Im(lambda) != 0. stable : Re(lambda) < 0 or neutral. neutral : |lambda| <
     :data:`NEUTRAL_RATE`. label : classification. energy : kinetic-energy share per state group.
     shape : real-ified transverse tether shape, anchor (0) to confluence point.
     sign_changes : sign changes of the shape along the moving nodes.

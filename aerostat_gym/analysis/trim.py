@@ -180,27 +180,45 @@ def _newton(model: Model, x: np.ndarray, tol: float, max_iter: int) -> tuple[np.
     return x, rel, max_iter
 
 
+def _continue(solve, x: np.ndarray, s: float, target: float, step: float, max_step: float,
+              min_step: float, tol: float) -> tuple[np.ndarray, float, float, int, float | None]:
+    """Newton continued in a parameter from the solution ``x`` at ``s`` to ``target``: a step
+    ``solve(next, x)`` -> (x, relative residual, iterations) is accepted where the residual is
+    within ``tol``, after which the step doubles (up to ``max_step``), and halved on a failure.
+    Returns (x, s, residual, iterations, stalled): ``stalled`` is None where ``target`` was
+    reached, else the value that still failed when the step fell below ``min_step``."""
+    rel, its = 0.0, 0
+    while True:
+        nxt = min(s + step, target) if target >= s else max(s - step, target)
+        xn, rel, it = solve(nxt, x.copy())
+        its += it
+        if rel <= tol:
+            x, s = xn, nxt
+            if s == target:
+                return x, s, rel, its, None
+            step = min(max_step, 2 * step)
+        else:
+            step /= 2
+            if step < min_step:
+                return x, s, rel, its, nxt
+
+
 def _continue_in_wind(model: Model, x: np.ndarray, u: float, wind_speed: float,
                       max_step: float, tol: float) -> tuple[np.ndarray, float, int]:
     """Newton continued in wind speed from the equilibrium ``x`` at ``u`` to ``wind_speed`` in
     steps of at most ``max_step`` (halved on failure down to 1/64 of it): (x, residual,
     iterations); TrimError where it stalls."""
-    rel, its, step = 0.0, 0, max_step
-    while True:
-        target = min(u + step, wind_speed) if wind_speed >= u else max(u - step, wind_speed)
+
+    def solve(target: float, x0: np.ndarray):
         model.set_wind(target)
-        xn, rel, it = _newton(model, x.copy(), tol, 40)
-        its += it
-        if rel <= tol:
-            x, u = xn, target
-            if u == wind_speed:
-                return x, rel, its
-            step = min(max_step, 2 * step)
-        else:
-            step /= 2
-            if step < max_step / 64:
-                raise TrimError(f"no equilibrium found at U = {target:.3f} m/s (continuing from "
-                                f"{u:.3f} m/s): relative residual {rel:.2e} > {tol:.0e}")
+        return _newton(model, x0, tol, 40)
+
+    x, u, rel, its, stalled = _continue(solve, x, u, wind_speed, max_step, max_step,
+                                        max_step / 64, tol)
+    if stalled is not None:
+        raise TrimError(f"no equilibrium found at U = {stalled:.3f} m/s (continuing from "
+                        f"{u:.3f} m/s): relative residual {rel:.2e} > {tol:.0e}")
+    return x, rel, its
 
 
 #: Where the tether weighs more than this share of the net lift, a failed continuation in wind
@@ -215,7 +233,8 @@ _WEIGHT_STEP_MIN = 1.0 / 256
 
 
 def _continue_in_tether_weight(params: Params, wind_speed: float, max_step: float, tol: float,
-                               length: float | None, cause: TrimError) -> tuple[np.ndarray, float, int]:
+                               length: float | None,
+                               cause: TrimError) -> tuple[np.ndarray, float, int]:
     """Trim at ``wind_speed`` with a lighter tether (weighing LIFT_MARGIN_SHARE of the net lift,
     whose trim is well conditioned), then continue the tether's density back to its own value
     at that wind speed, in adaptive steps. Raises TrimError naming the net-lift margin where
@@ -242,21 +261,16 @@ def _continue_in_tether_weight(params: Params, wind_speed: float, max_step: floa
                                         wind_speed, max_step, tol)
     except TrimError:
         raise fail("failed too") from cause
-    s, step = 0.0, 0.25
-    while s < 1.0:
-        sn = min(1.0, s + step)
-        model = Model(lighter(sn), 0.0)
+    def solve(share: float, x0: np.ndarray):
+        model = Model(lighter(share), 0.0)
         model.set_wind(wind_speed)
-        xn, rel, it = _newton(model, x.copy(), tol, 40)
-        its += it
-        if rel <= tol:
-            x, s, step = xn, sn, min(0.5, 2 * step)
-        else:
-            step /= 2
-            if step < _WEIGHT_STEP_MIN:
-                raise fail(f"stalled at {100 * s:.1f} % of the way to this tether's weight "
-                           f"(relative residual {rel:.2e} > {tol:.0e})") from cause
-    return x, rel, its
+        return _newton(model, x0, tol, 40)
+
+    x, s, rel, more, stalled = _continue(solve, x, 0.0, 1.0, 0.25, 0.5, _WEIGHT_STEP_MIN, tol)
+    if stalled is not None:
+        raise fail(f"stalled at {100 * s:.1f} % of the way to this tether's weight "
+                   f"(relative residual {rel:.2e} > {tol:.0e})") from cause
+    return x, rel, its + more
 
 
 def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,

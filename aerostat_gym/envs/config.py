@@ -126,7 +126,8 @@ class TaskConfig:
     def __post_init__(self):
         r = self.resolved
         r["wind_speed"] = _range("wind_speed", self.wind_speed, hi_max=MAX_WIND_SPEED)
-        perturbation(self.perturbation)  # named at the door, before the parameters load
+        # named at the door, before the parameters load (the gust against the top mean wind too)
+        perturbation(self.perturbation, top_speed=r["wind_speed"][1])
         if self.integrator not in INTEGRATORS:
             raise TaskError(f"unknown integrator {self.integrator!r}; choose one of {INTEGRATORS}")
         check_control_step(self.control_step)
@@ -145,7 +146,6 @@ class TaskConfig:
             raise TaskError(f"wind_bank_seed must be an integer >= 0, got {self.wind_bank_seed!r}")
         r["params"] = self._params()
         r["perturbation"] = perturbation(self.perturbation, r["params"].tether.length)
-        check_gust_on_wind(r["perturbation"], r["wind_speed"][1])
         try:  # the field's heights and extent follow the configured aerostat, tether and winch
             r["turbulence"] = sized_turbulence(r["params"], self.turbulence)
         except (TypeError, ValueError) as exc:
@@ -296,12 +296,15 @@ MAX_GUST_DURATION = 3600.0
 MAX_GUST_ONSET = 86400.0
 
 
-def perturbation(spec, tether_length: float | None = None) -> dict:
+def perturbation(spec, tether_length: float | None = None,
+                 top_speed: float | None = None) -> dict:
     """A validated perturbation dict from a preset name or a (partial) dict. A preset's swing
     and lateral displacement are scaled to a tether of ``tether_length`` [m]
     (:func:`displacement_scale`; None: as stated, for the reference tether); a dict's are
     taken as given, in metres. Every field is bounded (:func:`_check_displacements`,
-    :func:`_check_gust`): a TaskError names the field, its value and the bound."""
+    :func:`_check_gust`; with ``top_speed`` [m/s], the task's highest mean wind, also the gust
+    on it, :func:`_check_gust_on_wind`): a TaskError names the field, its value and the
+    bound."""
     if isinstance(spec, str):
         if spec not in PERTURBATIONS:
             raise TaskError(f"unknown perturbation {spec!r}; choose one of {list(PERTURBATIONS)}"
@@ -320,6 +323,8 @@ def perturbation(spec, tether_length: float | None = None) -> dict:
         raise TaskError(f"perturbation fixed must be True or False, got {out['fixed']!r}")
     _check_displacements(out, tether_length)
     _check_gust(out)
+    if top_speed is not None:
+        _check_gust_on_wind(out, top_speed)
     return out
 
 
@@ -342,7 +347,7 @@ def _check_displacements(out: dict, tether_length: float | None) -> None:
                             f"{top:g} {units[k]}")
 
 
-def check_gust_on_wind(pert: dict, top_speed: float) -> None:
+def _check_gust_on_wind(pert: dict, top_speed: float) -> None:
     """The largest gust on the largest mean wind stays within MAX_WIND_SPEED: the gust adds to
     the mean wind, and the model's incompressible aerodynamics end there."""
     gust = pert["gust_amplitude"][1] if pert["gust_probability"] > 0 else 0.0

@@ -272,8 +272,8 @@ class TetheredAerostatEnv(gym.Env):
       it too (an AttributeError), and every call but ``close()`` after ``close()`` raises
       ``gymnasium.error.ClosedEnvironmentError`` (ran on in calm air); the perturbation's
       fields are bounded (swing and lateral by the tether length, pitch by pi/2, gust
-      amplitude plus the top mean wind by 100 m/s, duration in (0, 3600] s, onset by 86400 s) and a turbulence bank
-      above 4 GiB (``aerostat_gym.wind.synthesis.MAX_FIELD_BYTES``) is a ``TaskError`` at make
+      amplitude plus the top mean wind by 100 m/s, duration in (0, 3600] s, onset by
+      86400 s) and a turbulence bank above 4 GiB (``aerostat_gym.wind.synthesis.MAX_FIELD_BYTES``) is a ``TaskError`` at make
       (was a NumPy MemoryError); the native vector env's infos are ``SyncVectorEnv``'s (plain
       reset keys, ``final_info``, ``time``; no ``truncation`` reason at a time limit). With
       the winch off the origin (``tether.anchor_position``) the start's swing pivots on the
@@ -282,7 +282,9 @@ class TetheredAerostatEnv(gym.Env):
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
-    _ready = False  # set by reset() and set_state(), cleared by close()
+    #: an episode runs and the env is open, so step() may go on: set by reset() and
+    #: set_state(), cleared by close() (a class default: also for instances made before it)
+    _ready = False
 
     def __init__(self, render_mode: str | None = None, **kwargs):
         if render_mode is not None and render_mode not in RENDER_MODES:
@@ -295,7 +297,6 @@ class TetheredAerostatEnv(gym.Env):
         self.observation_space = gym.spaces.Box(b.obs_low, b.obs_high, dtype=np.float32)
         self.metadata = {**self.metadata, "render_fps": round(1.0 / self.task.control_step)}
         self._renderer = None
-        self._ready = False  # an episode runs and the env is open: step() may go on
 
     # --- Gymnasium API ---------------------------------------------------------------------
 

@@ -30,7 +30,7 @@ from ..physics.wind import (
 from ..sim import Model
 from ..wind.presets import TurbulenceConfig
 from ..wind.synthesis import check_field_size, fft_length, veers_field
-from .config import TaskConfig, TaskError, check_gust_on_wind, get_parameter, perturbation
+from .config import TaskConfig, TaskError, get_parameter, perturbation
 
 #: [m/s] step of the trim table: the trims are computed once per parameter set by continuation
 #: in wind speed on this grid (0.7 s for 3-15 m/s on the baseline) and episodes draw their speed
@@ -237,10 +237,9 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
     unknown = sorted(set(opts) - {"wind_speed", "perturbation"})
     if unknown:
         raise TaskError(f"unknown reset option(s) {unknown}; known: ['perturbation', 'wind_speed']")
-    pert = (perturbation(opts["perturbation"], trims.params.tether.length)
+    pert = (perturbation(opts["perturbation"], trims.params.tether.length,
+                         float(trims.speeds[-1]))
             if "perturbation" in opts else task.resolved["perturbation"])
-    if "perturbation" in opts:
-        check_gust_on_wind(pert, float(trims.speeds[-1]))
     U = _episode_speed(trims, opts.get("wind_speed"), rng)
     params, x_trim = _parameters(task, trims, U, rng)
     k = trims.index(U)

@@ -58,7 +58,9 @@ class TetheredAerostatVectorEnv(VectorEnv):
     ``close()`` after ``close()`` raises ``gymnasium.error.ClosedEnvironmentError``."""
 
     metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
-    _ready = False  # set by reset() once every slot has an episode, cleared by close()
+    #: every slot has an episode and the env is open, so step() may go on: set by reset(),
+    #: cleared by close() (a class default: also for instances made before it)
+    _ready = False
 
     def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
@@ -89,7 +91,6 @@ class TetheredAerostatVectorEnv(VectorEnv):
         # ended, not stepped: NEXT_STEP resets these at the next step, DISABLED waits for reset()
         self._pending = np.zeros(num_envs, dtype=np.bool_)
         self._renderer = None
-        self._ready = False  # every slot has an episode and the env is open: step() may go on
 
     # --- Gymnasium VectorEnv API -----------------------------------------------------------
 
