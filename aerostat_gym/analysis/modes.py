@@ -26,6 +26,8 @@ from .linear import Decoupled, LinearModel, decouple, linearize
 from .trim import Equilibrium, TrimError, find_equilibrium
 
 SETS = ("long", "lat")
+#: The decoupled subsets by name, as the reports print them.
+SET_NAMES = {"long": "longitudinal", "lat": "lateral"}
 #: |lambda| below this [rad/s] (a period above about 17 h) counts as a neutral rigid-body mode:
 #: at zero wind the whole system may turn about the vertical through the anchor, a double zero
 #: eigenvalue that finite differences split into +-sqrt(rounding), a few 1e-5.

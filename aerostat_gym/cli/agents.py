@@ -16,7 +16,7 @@ from ..agents.report import (
     write_report,
 )
 from ..agents.train import ALGOS, train
-from ..analysis.modes import analyse
+from ..analysis.modes import SET_NAMES, analyse
 from ..analysis.trim import find_equilibrium
 from ..envs.batch import trim_table
 from ..envs.config import TaskConfig
@@ -186,7 +186,7 @@ def demo_summary(params, wind: float, label: str = "baseline") -> list[str]:
                            ("lat", "pendulum"), ("lat", "rolling")):
         m = ana.find(subset, label_)
         if m is not None:
-            name = {"long": "longitudinal", "lat": "lateral"}[subset]
+            name = SET_NAMES[subset]
             lines.append(f"    {name:12s} {label_:13s} {m.describe()}")
     return lines
 

@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from ..analysis.figures import figure9_data, write_figure9
-from ..analysis.modes import FIGURE9_MODES, SETS, wind_sweep
+from ..analysis.modes import FIGURE9_MODES, SET_NAMES, SETS, wind_sweep
 from ..analysis.reference import format_table2, table2
 from ..analysis.sensitivity import (
     DAMPING_SPEEDS,
@@ -122,7 +122,7 @@ def _unstable_line(entry: dict) -> str:
     table has its column (a divergent real eigenvalue beside the lateral pendulum has none):
     where it is unstable and its eigenvalue where it grows fastest."""
     worst = entry["worst"]
-    subset = {"long": "longitudinal", "lat": "lateral"}[entry["set"]]
+    subset = SET_NAMES[entry["set"]]
     return (f"  UNSTABLE {subset} {entry['label']} at U = {_speeds_text(entry['values'])}; "
             f"fastest at {entry['worst_value']:g} m/s: lambda = "
             f"{_eigenvalue_text(worst.eigenvalue)} 1/s, {worst.describe().strip()}")
