@@ -514,11 +514,11 @@ def hull_integral_warnings(p: Params) -> list[str]:
 # A unit slip (MPa written as Pa, cm as m) passes every per-field check and the feasibility
 # checks, loads, and then fails every episode at step 0 far from its cause. The bounds below are
 # refused at the door (:func:`check_plausibility`, run by load_params on the file and its
-# overrides alike); values that are unusual but possible only warn (:func:`plausibility_warnings`,
+# overrides alike, and by the environment when it is made); values that are unusual but possible only warn (:func:`plausibility_warnings`,
 # a ParameterWarning). Every bound is generous: aerostats from 5 m to 70 m hulls, tethers from
 # 20 m to 5 km of Dyneema, Kevlar, Vectran, polyester or steel-armoured conductor cable all pass.
 # They are not checked by Params.replace / apply_overrides, so that studies may still move one
-# value past them on purpose (a weightless tether, RK4 past its stability bound).
+# value past them on purpose (a weightless tether, RK4 past its stability bound) in the simulator.
 
 
 class ImplausibleParameterError(ParameterError):
@@ -626,7 +626,8 @@ def check_limits(p: Params) -> None:
 
 def check_plausibility(p: Params) -> None:
     """Refuse values that load but no real aerostat has (:class:`ImplausibleParameterError`),
-    naming the field, the value, the bound and the likely slip. Run by :func:`load_params`."""
+    naming the field, the value, the bound and the likely slip. Run by :func:`load_params` and
+    when an environment is made."""
     a, t, d = p.aerostat, p.tether, p.derived
     E = t.youngs_modulus
     # tether: its stretch under its own breaking strength and under the net lift

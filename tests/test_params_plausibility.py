@@ -267,6 +267,26 @@ def test_studies_may_still_move_values_past_the_door():
         load_params(overrides={"simulation.rk4_safety": 1.4})
 
 
+@pytest.mark.parametrize("over, texts", [
+    ({"tether.density": 0.975}, ("tether.density = 0.975", "looks like g/cm^3 written as kg/m^3")),
+    ({"tether.youngs_modulus": 37.4e3}, ("tether.youngs_modulus = 37400 Pa",
+                                         "looks like MPa written as Pa")),
+    ({"simulation.rk4_safety": 1.4}, ("simulation.rk4_safety = 1.4", "1.02")),
+])
+def test_the_env_is_a_door_too(over, texts):
+    """gym.make's overrides and a Params built by replace() meet the loader's bounds when the
+    env is made (a study that needs such values runs the simulator, past the door)."""
+    import gymnasium as gym
+
+    import aerostat_gym  # noqa: F401  (registers the tasks)
+    for make in (lambda: gym.make("TetheredAerostat-v0", overrides=over),
+                 lambda: gym.make("TetheredAerostat-v0", params=BASE.replace(**over))):
+        with pytest.raises(ImplausibleParameterError) as err:
+            make()
+        for t in texts:
+            assert t in str(err.value)
+
+
 # --- a UTF-8 byte-order mark -------------------------------------------------------------------
 
 def test_a_utf8_bom_is_accepted(tmp_path):

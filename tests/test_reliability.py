@@ -24,6 +24,7 @@ from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.bench.soak import STRESS_PERTURBATION
 from aerostat_gym.cli import main as cli_main
 from aerostat_gym.envs import ActionError, TaskError, TetheredAerostatEnv, episodes
+from aerostat_gym.envs import config as config_module
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
 from aerostat_gym.params import ParameterError, load_params
 from aerostat_gym.physics.wind import NO_FIELD, W_FIELD_T0, air_velocity, pack_wind, set_field
@@ -281,9 +282,19 @@ def test_6_nonfinite_output_is_reported_and_observation_finite():
     assert np.all(np.isfinite(obs))
 
 
-def test_6_rk4_past_its_stability_step_is_a_numerical_failure():
-    """RK4 at 1.4 times its stability bound blows up; the episode ends as a numerical
-    failure, never as a tether break or a length-limit excursion."""
+def test_6_rk4_past_its_stability_step_is_refused_at_the_door():
+    """The env's overrides meet the loader's plausibility bounds: 1.4 x the RK4 bound is
+    refused when the env is made, naming the field and the measured limit (1.02)."""
+    with pytest.raises(ParameterError, match=r"simulation.rk4_safety = 1.4 exceeds 1.02"):
+        _quiet(TetheredAerostatEnv, integrator="rk4", overrides={"simulation.rk4_safety": 1.4},
+               wind_speed=(10.0, 10.0), n_elements=5, turbulence="none")
+
+
+def test_6_rk4_past_its_stability_step_is_a_numerical_failure(monkeypatch):
+    """Past the door (its plausibility check switched off here), RK4 at 1.4 times its
+    stability bound blows up; the episode ends as a numerical failure, never as a tether
+    break or a length-limit excursion."""
+    monkeypatch.setattr(config_module, "check_plausibility", lambda p: None)
     env = _quiet(TetheredAerostatEnv, integrator="rk4", overrides={"simulation.rk4_safety": 1.4},
                  wind_speed=(10.0, 10.0), n_elements=5, turbulence="none",
                  perturbation="displacement")

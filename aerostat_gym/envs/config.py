@@ -21,6 +21,7 @@ from ..params import (
     apply_overrides,
     as_params,
     check_inertia,
+    check_plausibility,
     parameter_key,
     params_to_dict,
 )
@@ -164,7 +165,11 @@ class TaskConfig:
             over["tether.length"] = self.tether_length
         if self.n_elements is not None:
             over["tether.n_elements"] = self.n_elements
-        return apply_overrides(p, over) if over else p
+        p = apply_overrides(p, over) if over else p
+        # the env is a door like the loader: overrides and a Params built by replace() meet the
+        # same plausibility bounds as a parameter file
+        check_plausibility(p)
+        return p
 
     def _randomize(self, params: Params) -> dict:
         if self.randomize is None or self.randomize is False:
