@@ -382,3 +382,25 @@ def test_trim_cache_is_bounded(monkeypatch):
     assert built == lengths
     episodes.TrimTable(replace(base, tether=replace(base.tether, length=200.0)), 3.0, 15.0)
     assert built == [*lengths, 200.0] and len(episodes._TRIMS) == 3
+
+
+def test_an_off_grid_reset_speed_is_trimmed_once_and_remembered(monkeypatch):
+    """A reset option off the 0.1 m/s grid is trimmed exactly (the start is an equilibrium:
+    < 1e-3 m drift in 10 s with the brake on) the first time; a second reset at that speed
+    reads the remembered trim: no trim runs, and the start is bit-identical."""
+    from aerostat_gym.envs import episodes
+
+    env = gym.make(ENV_ID, turbulence="none", perturbation="none")
+    obs1, _ = env.reset(seed=0, options={"wind_speed": 7.33})
+    state1 = env.unwrapped._batch.state[0].copy()
+    for _ in range(50):
+        obs, *_ = env.step(np.array([0.0], np.float32))
+    assert np.max(np.abs(obs[:3])) * 10.0 < 1e-3
+
+    def no_trim(*args, **kwargs):
+        raise AssertionError("the off-grid trim ran again")
+    monkeypatch.setattr(episodes, "find_equilibrium", no_trim)
+    obs2, info = env.reset(seed=1, options={"wind_speed": 7.33})
+    assert info["wind_speed"] == 7.33
+    np.testing.assert_array_equal(obs2, obs1)
+    np.testing.assert_array_equal(env.unwrapped._batch.state[0], state1)

@@ -32,8 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.reference import reference_periods
-from ..envs.config import TaskError, check_control_step
-from ..envs.config import _range as wind_speed_range
+from ..envs.config import TaskError, check_control_step, check_range
 from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION, as_batch, check_obs_noise
 from ..params import Params, as_params
 from ..physics.wind import MAX_WIND_SPEED
@@ -240,7 +239,7 @@ def _wind_range(value) -> tuple[float, float] | None:
     if value is None:
         return None
     try:
-        return wind_speed_range("wind_range", value, hi_max=MAX_WIND_SPEED)
+        return check_range("wind_range", value, hi_max=MAX_WIND_SPEED)
     except TaskError as exc:
         raise PolicyError(str(exc)) from None
 

@@ -63,7 +63,7 @@ class TaskError(ValueError):
     """An invalid environment argument (the message names it and the value)."""
 
 
-def _range(name, value, lo_min=0.0, hi_max=math.inf):
+def check_range(name, value, lo_min=0.0, hi_max=math.inf):
     """A (low, high) range in [lo_min, hi_max]; a single number is the fixed value (value,
     value)."""
     pair = (value, value) if is_number(value) else value
@@ -126,7 +126,7 @@ class TaskConfig:
 
     def __post_init__(self):
         r = self.resolved
-        r["wind_speed"] = _range("wind_speed", self.wind_speed, hi_max=MAX_WIND_SPEED)
+        r["wind_speed"] = check_range("wind_speed", self.wind_speed, hi_max=MAX_WIND_SPEED)
         # named at the door, before the parameters load (the gust against the top mean wind too)
         perturbation(self.perturbation, top_speed=r["wind_speed"][1])
         if self.integrator not in INTEGRATORS:
@@ -370,12 +370,12 @@ def _check_gust(out: dict) -> None:
     p = out["gust_probability"]
     if not (is_finite_number(p) and 0 <= p <= 1):
         raise TaskError(f"perturbation gust_probability must be a number in [0, 1], got {p!r}")
-    out["gust_amplitude"] = _range("perturbation gust_amplitude [m/s]", out["gust_amplitude"],
+    out["gust_amplitude"] = check_range("perturbation gust_amplitude [m/s]", out["gust_amplitude"],
                                    hi_max=MAX_WIND_SPEED)
-    lo, hi = out["gust_duration"] = _range("perturbation gust_duration [s]",
+    lo, hi = out["gust_duration"] = check_range("perturbation gust_duration [s]",
                                            out["gust_duration"], hi_max=MAX_GUST_DURATION)
     if lo <= 0:
         raise TaskError(f"perturbation gust_duration must be > 0 s (a gust of no length has no "
                         f"shape), got {out['gust_duration']!r}")
-    out["gust_onset"] = _range("perturbation gust_onset [s]", out["gust_onset"],
+    out["gust_onset"] = check_range("perturbation gust_onset [s]", out["gust_onset"],
                                hi_max=MAX_GUST_ONSET)

@@ -36,7 +36,7 @@ from .config import TaskConfig, TaskError, get_parameter, perturbation
 #: in wind speed on this grid (0.7 s for 3-15 m/s on the baseline) and episodes draw their speed
 #: among its points, which is what makes a reset cheap; a fixed speed off the grid (the task's
 #: single ``wind_speed`` or a reset option) is trimmed exactly from its nearest table trim (a
-#: few ms per reset)
+#: few ms, the first time the environment meets that speed)
 WIND_GRID = 0.1
 #: [m/s] a speed this close to a grid point is that grid point (binary fractions of 0.1)
 GRID_TOL = 1e-9
@@ -60,6 +60,8 @@ MAX_INERTIA_REDRAWS = 1000
 #: the most trim tables kept by the cache (one per parameter set and wind range; a process that
 #: walks through many parameter sets, such as a sweep, evicts the oldest first)
 MAX_CACHED_TRIMS = 16
+#: the most off-grid nominal trims an environment remembers (reset options at fixed speeds)
+MAX_OFF_GRID_TRIMS = 64
 _TRIMS: dict = {}
 
 
@@ -98,6 +100,18 @@ class TrimTable:
             _TRIMS[key] = _build_trims(params, self.speeds)
         # winch-end tension (the winch's load) and the largest (the tether's, top end) per speed
         self.states, self.tensions, self.largest_tensions = _TRIMS[key]
+        #: nominal trims at off-grid speeds already asked for (reset options), by speed
+        self.off_grid: dict[float, np.ndarray] = {}
+
+    def off_grid_trim(self, speed: float) -> np.ndarray:
+        """The nominal trim at an off-grid ``speed``, continued from the nearest table trim
+        the first time and remembered (at most :data:`MAX_OFF_GRID_TRIMS` speeds, the oldest
+        forgotten first), so an episode reset at the same speed again costs no trim."""
+        if speed not in self.off_grid:
+            while len(self.off_grid) >= MAX_OFF_GRID_TRIMS:
+                del self.off_grid[next(iter(self.off_grid))]
+            self.off_grid[speed] = _continued_trim(self.params, self, speed)
+        return self.off_grid[speed].copy()
 
     def equilibrium(self, k: int) -> Equilibrium:
         return Equilibrium(self.states[k].copy(), float(self.speeds[k]), self.params, 0.0, 0, {})
@@ -300,7 +314,7 @@ def _parameters(task: TaskConfig, trims: TrimTable, U: float, rng) -> tuple[Para
         if k is not None:
             return trims.params, trims.states[k].copy()
         try:  # between two table trims of the same parameters: a failure is not expected
-            return trims.params, _continued_trim(trims.params, trims, U)
+            return trims.params, trims.off_grid_trim(U)
         except TrimError as exc:
             raise TaskError(f"wind_speed {U} m/s: no trim for these parameters: {exc}") from None
     base = trims.params
