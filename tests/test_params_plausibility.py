@@ -306,36 +306,133 @@ def test_a_bom_in_the_middle_is_still_invalid_toml(tmp_path):
 # --- trim with a small net-lift margin -----------------------------------------------------------
 
 LOW_MARGIN = {"aerostat.mass": 587.9}  # net lift 72.5 N, tether weight 69.9 N
+COMFORTABLE = {"aerostat.mass": 586.0}  # net lift 91.2 N
+
+
+def _margin(p) -> float:
+    """Net lift minus the tether's weight [N]: the winch tension in still air."""
+    return p.derived.net_lift - p.derived.tether_weight
+
+
+def _with_margin(p, share: float):
+    """``p`` with the aerostat's mass set so that the margin is ``share`` of the net lift."""
+    d = p.derived
+    net_lift = d.tether_weight / (1.0 - share)
+    return p.replace(**{"aerostat.mass": (d.buoyancy - net_lift) / p.environment.g})
+
+
+def _continued_in_mass(p, wind_speed: float, start):
+    """The reference equilibrium: the trim of ``p`` with the lighter aerostat ``start`` (a wider
+    margin) at this wind speed, continued in aerostat mass to ``p``'s: another path, through
+    another Newton start, to the same equilibrium."""
+    near = find_equilibrium(start, wind_speed)
+    ref = find_equilibrium(p, wind_speed, guess=near)
+    assert ref.residual <= REL_TOL
+    return ref
+
+
+def _assert_same_trim(eq, ref):
+    """Two trims agree to 1 micrometre (positions) and microradian (attitude), and their end
+    tensions to 1 ppm; both are flying equilibria."""
+    assert eq.residual <= REL_TOL
+    assert max(abs(eq.x - ref.x)) < 1e-6
+    for end in ("top_tension_N", "winch_tension_N"):
+        assert eq.summary[end] == pytest.approx(ref.summary[end], rel=1e-6)
+    assert eq.summary["min_tension_N"] > 0 and eq.summary["aerostat_position_m"][2] > 0
 
 
 def test_low_margin_trims_at_10_m_s():
-    """The audit's case: the continuation in wind from the vertical zero-wind line stalls at
-    0.078 m/s; the trim is reached from a lighter tether instead, and is the equilibrium that
-    a continuation in aerostat mass (from 586 kg, 91 N net lift) finds (5.6e-11 m apart)."""
+    """The audit's case at 10 m/s is the equilibrium that a continuation in aerostat mass (from
+    586 kg, 91 N net lift) finds."""
     p = load_params(overrides=LOW_MARGIN)
     d = p.derived
     assert d.net_lift == pytest.approx(72.5, abs=0.05)
     assert d.tether_weight == pytest.approx(69.9, abs=0.05)
-    eq = find_equilibrium(p, 10.0)
-    assert eq.residual <= REL_TOL
-    near = find_equilibrium(load_params(overrides={"aerostat.mass": 586.0}), 10.0)
-    ref = find_equilibrium(p, 10.0, guess=near)
-    assert ref.residual <= REL_TOL
-    assert max(abs(eq.x - ref.x)) < 1e-6
-    s = eq.summary
-    assert s["winch_tension_N"] == pytest.approx(ref.summary["winch_tension_N"], rel=1e-6)
-    assert s["min_tension_N"] > 0 and s["aerostat_position_m"][2] > 0
+    _assert_same_trim(find_equilibrium(p, 10.0),
+                      _continued_in_mass(p, 10.0, load_params(overrides=COMFORTABLE)))
+
+
+@pytest.mark.parametrize("wind_speed", [0.5, 1.0, 2.0, 3.0, 5.0])
+def test_low_margin_trims_in_light_wind(wind_speed):
+    """In light wind the lower tether of the audit's case carries a few newtons (9 N at 1 m/s)
+    and the trim is ill-conditioned: Newton's force-decrease line search crept in steps of
+    1/64 to 1/8 and the continuation in wind stalled at 0.078 m/s after 5 to 25 s. With the
+    natural monotonicity test it takes full steps (34 iterations at 1 m/s, 0.1 s) to the
+    equilibrium a continuation in mass reaches."""
+    p = load_params(overrides=LOW_MARGIN)
+    eq = find_equilibrium(p, wind_speed)
+    assert eq.iterations < 100
+    _assert_same_trim(eq, _continued_in_mass(p, wind_speed, load_params(overrides=COMFORTABLE)))
+
+
+def test_low_margin_trim_leaves_the_still_air_line_as_u_squared():
+    """Closed form at the light-wind end: in still air the tether hangs vertical, carrying the
+    net lift at the top and the margin (2.6 N) at the winch. The wind's forces on the hull and
+    the tether grow as U^2, so the winch tension rises above the margin as U^2: doubling the
+    wind from 0.1 to 0.2 m/s quadruples the excess (4.06: the blow-by, 0.06 to 0.24 deg,
+    bends the line a little)."""
+    p = load_params(overrides=LOW_MARGIN)
+    still = find_equilibrium(p, 0.0).summary
+    assert still["winch_tension_N"] == pytest.approx(_margin(p), rel=1e-9)
+    assert still["top_tension_N"] == pytest.approx(p.derived.net_lift, rel=1e-9)
+    excess = [find_equilibrium(p, u).summary["winch_tension_N"] - _margin(p) for u in (0.1, 0.2)]
+    assert 0.02 < excess[0] < 0.03  # N
+    assert excess[1] / excess[0] == pytest.approx(4.0, rel=0.03)
+
+
+def test_the_heaviest_loadable_aerostat_trims():
+    """The heaviest aerostat whose net lift exceeds the tether's weight weighs (buoyancy -
+    tether weight) / g = 588.168 kg on the baseline; 1 g more is refused at load. 1 g less (a
+    margin of 0.01 N) trims at 1 m/s, to the equilibrium continued in mass from 587.9 kg."""
+    d, g = BASE.derived, BASE.environment.g
+    heaviest = (d.buoyancy - d.tether_weight) / g
+    assert heaviest == pytest.approx(588.168, abs=5e-4)
+    with pytest.raises(ParameterError, match="cannot lift its tether"):
+        load_params(overrides={"aerostat.mass": heaviest + 1e-3})
+    p = load_params(overrides={"aerostat.mass": heaviest - 1e-3})
+    assert _margin(p) == pytest.approx(1e-3 * g)
+    _assert_same_trim(find_equilibrium(p, 1.0),
+                      _continued_in_mass(p, 1.0, load_params(overrides=LOW_MARGIN)))
+
+
+@pytest.mark.parametrize("name, wind_speed", [("7m_hull_50m_tether", 1.0),
+                                              ("7m_hull_50m_tether", 10.0), ("tcom_32m", 1.0)])
+def test_other_aerostats_with_a_1_percent_margin_trim(name, wind_speed):
+    """A margin of 1 % of the net lift on a small aerostat (stalled at 0.016 m/s, at 1 and at
+    10 m/s alike) and on the 32 m one (stalled at 0.094 m/s): the trim is the one continued
+    in mass from a margin of 20 %."""
+    p = load_params(name) if name in shipped_configs() else scale_aerostat(BASE, *REAL[name])
+    low = _with_margin(p, 0.01)
+    assert _margin(low) == pytest.approx(0.01 * low.derived.net_lift)
+    _assert_same_trim(find_equilibrium(low, wind_speed),
+                      _continued_in_mass(low, wind_speed, _with_margin(p, 0.2)))
+
+
+def test_a_paid_out_tether_heavier_than_the_net_lift_needs_wind():
+    """400 m paid out (the winch's longest) weigh 93.2 N, more than the 72.5 N of net lift: at
+    2 m/s the model's only equilibrium hangs the tether 17 m below the ground (it has no ground),
+    which is refused naming the weights; at 10 m/s the hull's lift carries the tether."""
+    p = load_params(overrides=LOW_MARGIN)
+    assert p.winch.max_length == 400.0
+    with pytest.raises(TrimError) as err:
+        find_equilibrium(p, 2.0, length=400.0)
+    msg = str(err.value)
+    assert "below the ground" in msg and "U = 2 m/s" in msg
+    assert "net lift (72.5 N)" in msg and "400 m of tether paid out (93.2 N)" in msg
+    s = find_equilibrium(p, 10.0, length=400.0).summary
+    assert s["elevation_at_winch_deg"] > 0 and s["min_tension_N"] > 0
 
 
 def test_low_margin_failure_names_the_margin():
     """Where the trim cannot be reached (here: an unreachable tolerance), the error gives the
-    net lift, the tether's weight and the margin between them."""
+    net lift, the tether's weight, the margin between them and the wind speed, and fails fast
+    (0.3 s)."""
     p = load_params(overrides=LOW_MARGIN)
     with pytest.raises(TrimError) as err:
         find_equilibrium(p, 10.0, tol=1e-30)
     msg = str(err.value)
     assert "net lift (72.5 N)" in msg and "tether (69.9 N)" in msg and "by only 2.6 N" in msg
-    assert "aerostat.mass" in msg
+    assert "U = 10 m/s" in msg and "aerostat.mass" in msg
 
 
 def test_a_comfortable_margin_keeps_the_plain_message():

@@ -4,7 +4,10 @@
 (all velocities zero, winch braked): the generalized forces on every tether node and on the
 aerostat (force in body axes, moment about the CM) vanish. Newton's method with a central
 finite-difference Jacobian and a minimum-norm least-squares step (at zero wind the yaw angle
-is undetermined; the min-norm step leaves it where it is) and a backtracking line search.
+is undetermined; the min-norm step leaves it where it is) and a backtracking line search
+that keeps a step where it lowers the largest generalized force or, failing that, shortens the
+next Newton correction (:func:`_step_accepted`: the force test alone creeps where the lower
+tether is nearly slack).
 
 The cost grows gently with the number of elements n. Node j's generalized force depends only
 on nodes j - 1, j, j + 1 (and the top node's on the aerostat), so the Jacobian is banded with
@@ -149,6 +152,29 @@ def _newton_step(J: np.ndarray, r: np.ndarray) -> np.ndarray:
     return np.linalg.lstsq(J, -r, rcond=1e-13)[0]
 
 
+def _step_accepted(J: np.ndarray, dz: np.ndarray, lam: float, rel: float, rn: np.ndarray,
+                   reln: float) -> bool:
+    """Whether the damped Newton step lam dz (relative residual rel -> reln, new residual rn)
+    is kept: where it lowers the largest generalized force, else where it passes Deuflhard's
+    natural monotonicity test, the next Newton correction from this Jacobian being shorter,
+    |J^-1 F(x + lam dz)| <= (1 - lam / 4) |dz| (metres and radians).
+
+    The second test is what a nearly slack lower tether needs: its lateral stiffness T / l is
+    tiny beside its axial one EA / l (0.2 against 35 000 N/m for 6 N in the baseline's 30 m
+    elements), so a lateral correction d that cures a force (T / l) d also stretches the element
+    by d^2 / (2 l), an axial force (EA / l) d^2 / (2 l) far above it (d = 5 cm: 1.5 N against
+    0.01 N). The next correction, an axial d^2 / (2 l), undoes it: Newton converges with full
+    steps, but a force decrease admits steps of 1/64 to 1/8 only, and the iteration creeps
+    until the continuation stalls (aerostat.mass = 587.9 kg on the baseline: at 0.078 m/s).
+    The force test comes first, so a trim whose full steps lower the force (the baseline's,
+    1 to 30 m/s) takes the same path as with that test alone."""
+    if not np.all(np.isfinite(rn)):
+        return False
+    if reln < rel:
+        return True
+    return bool(np.linalg.norm(_newton_step(J, rn)) <= (1.0 - lam / 4) * np.linalg.norm(dz))
+
+
 def _newton(model: Model, x: np.ndarray, tol: float, max_iter: int) -> tuple[np.ndarray, float, int]:
     idx = _unknown_index(model)
     scale = model.params.derived.buoyancy
@@ -171,7 +197,7 @@ def _newton(model: Model, x: np.ndarray, tol: float, max_iter: int) -> tuple[np.
             xn[idx] += lam * dz
             rn = _residual(model, xn)
             reln = np.max(np.abs(rn)) / scale
-            if np.all(np.isfinite(rn)) and reln < rel:
+            if _step_accepted(J, dz, lam, rel, rn, reln):
                 break
             lam *= 0.5
         else:
@@ -225,11 +251,18 @@ def _continue_in_wind(model: Model, x: np.ndarray, u: float, wind_speed: float,
 #: is retried by continuation in the tether's weight (:func:`_continue_in_tether_weight`). With
 #: a small margin of net lift over tether weight the lower tether carries almost no tension in
 #: light wind, so its lateral stiffness (tension / element length) is tiny beside its axial one
-#: (EA / element length) and Newton from the vertical zero-wind line stalls (the baseline with
-#: aerostat.mass = 587.9 kg: 72.5 N net lift, 69.9 N of tether, stalled at 0.078 m/s).
+#: (EA / element length): the trim there is ill-conditioned, and a lighter tether is a second
+#: path to it. (With :func:`_step_accepted` the continuation in wind reaches these trims itself,
+#: down to a margin of 0.01 N on the baseline; where both paths fail the error names the margin.)
 LIFT_MARGIN_SHARE = 0.5
 #: Smallest continuation step in the tether's weight (share of the way to the real tether).
 _WEIGHT_STEP_MIN = 1.0 / 256
+
+
+def _paid_out_weight(params: Params, length: float | None) -> float:
+    """Weight [N] of the tether paid out (``length`` m, default ``tether.length``)."""
+    return params.derived.mass_per_length * (params.tether.length if length is None
+                                             else length) * params.environment.g
 
 
 def _continue_in_tether_weight(params: Params, wind_speed: float, max_step: float, tol: float,
@@ -240,20 +273,28 @@ def _continue_in_tether_weight(params: Params, wind_speed: float, max_step: floa
     at that wind speed, in adaptive steps. Raises TrimError naming the net-lift margin where
     this fails too."""
     d, rho = params.derived, params.tether.density
-    f = LIFT_MARGIN_SHARE * d.net_lift / d.tether_weight
+    weight = _paid_out_weight(params, length)
+    f = LIFT_MARGIN_SHARE * d.net_lift / weight
 
     def lighter(s: float) -> Params:  # s = 0: the light tether, s = 1: the real one
         return params if s >= 1.0 else params.replace(**{"tether.density": rho * (f + (1 - f) * s)})
 
     def fail(where: str) -> TrimError:
-        margin = d.net_lift - d.tether_weight
+        margin = d.net_lift - weight
+        if margin > 0:
+            why = (f"the net lift ({d.net_lift:.1f} N) exceeds the weight of the tether "
+                   f"({weight:.1f} N) by only {margin:.1f} N ({100 * margin / d.net_lift:.1f} % "
+                   "of the net lift), so the lower tether is nearly slack in light wind and the "
+                   "trim is ill-conditioned")
+        else:  # in still air the winch tension would be the margin: only the wind can lift it
+            why = (f"the net lift ({d.net_lift:.1f} N) is below the weight of the tether paid "
+                   f"out ({weight:.1f} N) by {-margin:.1f} N, so only the wind's lift can hold "
+                   "the tether off the ground")
         return TrimError(
-            f"{cause}; the net lift ({d.net_lift:.1f} N) exceeds the weight of the tether "
-            f"({d.tether_weight:.1f} N) by only {margin:.1f} N ({100 * margin / d.net_lift:.1f} % "
-            "of the net lift), so the lower tether is nearly slack in light wind and the trim "
-            f"is ill-conditioned; continuing from a lighter tether {where}. A lighter aerostat "
-            "(aerostat.mass), a larger one (aerostat.volume) or a shorter or lighter tether "
-            "(tether.length, tether.density, tether.diameter) widens the margin")
+            f"{cause}; {why}; continuing from a lighter tether at U = {wind_speed:g} m/s "
+            f"{where}. A lighter aerostat (aerostat.mass), a larger one (aerostat.volume) or a "
+            "shorter or lighter tether (length, tether.length, tether.density, tether.diameter) "
+            "widens the margin")
 
     try:
         start = Model(lighter(0.0), 0.0)
@@ -292,7 +333,8 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
     ``max_step`` (and, without a guess and where the tether weighs more than
     LIFT_MARGIN_SHARE of the net lift, also by continuation from a lighter tether at the
     target wind speed; the message then gives the net-lift margin), or if the solution has a
-    slack tether or the aerostat below the anchor.
+    slack tether, the aerostat on or below the ground or tether below the ground (where the
+    lift cannot carry the tether paid out: :func:`_check_flying`).
     """
     params = params or load_params()
     if not (is_finite_number(wind_speed) and 0 <= wind_speed <= MAX_WIND_SPEED):
@@ -307,17 +349,38 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
     try:
         x, rel, its = _continue_in_wind(model, x, u0, wind_speed, max_step, tol)
     except TrimError as exc:
-        d = params.derived
-        if guess is not None or d.tether_weight <= LIFT_MARGIN_SHARE * d.net_lift:
+        if guess is not None or (_paid_out_weight(params, length)
+                                 <= LIFT_MARGIN_SHARE * params.derived.net_lift):
             raise
         x, rel, its = _continue_in_tether_weight(params, wind_speed, max_step, tol, length, exc)
     model.set_wind(wind_speed)
     summary = trim_summary(model, x, wind_speed)
-    if summary["min_tension_N"] <= 0 or x[model.layout.cm_pos][2] <= 0:
-        raise TrimError(f"the solution at U = {wind_speed} m/s is not a flying equilibrium "
-                        f"(min tension {summary['min_tension_N']:.1f} N, height {x[model.layout.cm_pos][2]:.1f} m)")
+    _check_flying(model, x, summary, wind_speed)
     return Equilibrium(x=x, wind_speed=float(wind_speed), params=params, residual=float(rel),
                        iterations=its, summary=summary)
+
+
+def _check_flying(model: Model, x: np.ndarray, summary: dict, wind_speed: float) -> None:
+    """TrimError where the solution is not a flying equilibrium: a slack element, the aerostat
+    on or below the ground, or tether below the ground. The last is the model's answer where
+    the net lift and the wind's lift cannot carry all of the tether paid out: having no ground,
+    the lumped tether leaves the winch downwards and hangs in a sag below it, where a real one
+    would lie on the ground (the baseline with aerostat.mass = 587.9 kg, 72.5 N of net lift,
+    on 400 m of tether, 93.2 N, at 1 m/s: 72 m below)."""
+    height = x[model.layout.cm_pos][2]
+    if summary["min_tension_N"] <= 0 or height <= 0:
+        raise TrimError(f"the solution at U = {wind_speed} m/s is not a flying equilibrium "
+                        f"(min tension {summary['min_tension_N']:.1f} N, height {height:.1f} m)")
+    depth = -float(model.node_positions(x)[:, 2].min())
+    if depth > 0:
+        p, length = model.params, float(x[model.layout.winch_length])
+        weight = _paid_out_weight(p, length)
+        raise TrimError(
+            f"the solution at U = {wind_speed:g} m/s hangs the tether {depth:.1f} m below the "
+            f"ground: the net lift ({p.derived.net_lift:.1f} N) and the wind's lift cannot hold "
+            f"the {length:g} m of tether paid out ({weight:.1f} N) off the ground. Less tether "
+            "(length), a lighter one (tether.density, tether.diameter), a lighter or larger "
+            "aerostat (aerostat.mass, aerostat.volume) or more wind can")
 
 
 def trim_summary(model: Model, x: np.ndarray, wind_speed: float) -> dict:
