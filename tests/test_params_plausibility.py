@@ -246,6 +246,8 @@ def test_limits_match_the_compiled_core():
     ({"tether.density": 12000.0}, "tether.density = 12000"),
     ({"tether.youngs_modulus": 3.0e9}, "tether.youngs_modulus = 3e+09"),  # nylon-like: 42 %
     ({"aerostat.volume": 300.0, "aerostat.mass": 120.0}, "aerostat.volume = 300"),
+    # 72.5 N of net lift carries 311 m of the 0.233 N/m line: 400 m (93.2 N) may be paid out
+    ({"aerostat.mass": 587.9}, "winch.max_length = 400 m of tether (93.2 N): paid out past 311 m"),
 ])
 def test_unusual_values_warn(over, field):
     with pytest.warns(ParameterWarning, match=re.escape(field)):
