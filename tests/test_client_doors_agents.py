@@ -5,6 +5,7 @@ building a model or writing a directory."""
 from __future__ import annotations
 
 import re
+import warnings
 
 import gymnasium as gym
 import numpy as np
@@ -332,3 +333,33 @@ def test_evaluate_checks_its_output_directory_before_evaluating(tmp_path, monkey
     assert capsys.readouterr().err == (f"aerostat-gym evaluate: error: --out {out}: cannot "
                                        "write there (Not a directory)\n")
     assert ran == []
+
+
+# --- a stateful policy's state dropped between steps ---------------------------------------------
+
+@pytest.mark.parametrize("name", ["modal_lqg", "shipped"])
+def test_dropping_a_stateful_policys_state_warns_once(name):
+    """``action, _ = policy.predict(obs)`` in a loop restarts the filter at every call: the
+    second such call on the same stream warns once (DroppedStateWarning naming the policy and
+    what its state holds), and its action is the first call's to the bit (both are episode
+    starts). Passing the state back, or marking each call as a start, does not warn."""
+    from aerostat_gym.agents.state_check import DroppedStateWarning
+
+    env = gym.make("TetheredAerostat-v0", wind_speed=10.0)
+    obs, _ = env.reset(seed=0)
+    policy = load_policy(name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DroppedStateWarning)
+        a0, state = policy.predict(obs)
+        a1, state = policy.predict(obs, state=state)  # passed back: no warning
+        policy.predict(obs, episode_start=np.array([True]))
+        policy.predict(obs, episode_start=np.array([True]))  # starts: no warning
+        policy.predict(np.stack([obs, obs]))  # another stream (two observations): no warning
+    with pytest.warns(DroppedStateWarning, match=r"predict got state=None on two calls in a "
+                                                 r"row: its state \(.*\) restarts"):
+        again, _ = policy.predict(obs)
+        again, _ = policy.predict(obs)
+    np.testing.assert_array_equal(again, a0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DroppedStateWarning)
+        policy.predict(obs)  # once per policy

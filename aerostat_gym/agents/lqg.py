@@ -60,6 +60,7 @@ from .lqr import (
     scheduled_tables,
 )
 from .modal import design_modal
+from .state_check import check_state_passed
 
 #: Standard observation channels the filter uses (name -> index), all longitudinal.
 MEASURED = {"dx": 0, "dz": 2, "vx": 3, "vz": 5, "dpitch": 7, "q": 10, "dtension": 13,
@@ -385,6 +386,8 @@ class LQGPolicy:
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """(actions, state): actions (1,) or (N, 1) float32 in [-1, 1]; state to pass back."""
         obs2, single = as_batch(observation, float, episode_start)
+        check_state_passed(self, state, episode_start, len(obs2), "the Kalman filter's "
+                           "estimate, the wind filter and the length integral")
         if obs2.ndim != 2 or obs2.shape[1] < N_OBS:
             raise ValueError(f"LQGPolicy needs the standard observation ({N_OBS} channels), got "
                              f"shape {np.shape(observation)}")

@@ -61,6 +61,7 @@ from ..checks import is_finite_number
 from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND, as_batch
 from ..params import Params, dumps_toml
 from ..physics.state import StateLayout
+from .state_check import check_state_passed
 from .swing_plane import in_swing_plane
 
 #: Bryson "largest acceptable deviation" of each state group (SI units), the integral of the
@@ -703,6 +704,7 @@ class LQRPolicy:
         """(actions, state): actions (1,) for one observation or (N, 1) for a batch, float32 in
         [-1, 1]; state is the (N,) array of integral states to pass back next step."""
         obs2, single = as_batch(observation, float, episode_start)
+        check_state_passed(self, state, episode_start, len(obs2), "the length integral")
         if obs2.ndim != 2 or obs2.shape[1] < self.obs_size:
             raise ValueError(
                 f"LQRPolicy needs the full-state observation of length {self.obs_size} "

@@ -26,6 +26,7 @@ import numpy as np
 from ..checks import is_finite_number
 from ..envs.spaces import N_OBS, as_batch
 from .sb3io import CommandShaper, PolicyError, check_lowpass_on
+from .state_check import check_state_passed
 
 #: Baselines that read the standard observation only, allowed as residual bases.
 RESIDUAL_BASES = ("lqg", "modal_lqg", "tension")
@@ -184,7 +185,9 @@ class ShapedPolicy:
         self.obs_dim = getattr(policy, "obs_dim", None)
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
-        _, single = as_batch(observation, episode_start=episode_start)
+        obs, single = as_batch(observation, episode_start=episode_start)
+        check_state_passed(self, state, episode_start, len(obs), "the command low-pass and "
+                           "the inner policy's state")
         state = state if isinstance(state, dict) else {}
         a, inner = self.policy.predict(observation, state=state.get("inner"),
                                        episode_start=episode_start, deterministic=deterministic)

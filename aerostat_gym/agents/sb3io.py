@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..envs.spaces import N_OBS, as_batch
+from .state_check import check_state_passed
 
 VECNORM_SUFFIX = "_vecnormalize.pkl"
 WRAPPERS_SUFFIX = "_wrappers.json"
@@ -173,6 +174,8 @@ class SB3Policy:
                 obs = self.norm.normalize_obs(obs)
             a, _ = self.model.predict(obs, deterministic=deterministic)
             return to_actions(np.asarray(a).reshape(-1), single), state
+        check_state_passed(self, state, episode_start, len(obs), "the base controller's, the "
+                           "command low-pass, the frame stack or the recurrent cells")
         n = len(obs)
         state = dict(state) if isinstance(state, dict) else {}
         start = (np.ones(n, bool) if episode_start is None and not state
