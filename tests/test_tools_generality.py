@@ -15,6 +15,7 @@ from aerostat_gym.analysis.figures import (
     damping_limits,
     figure9_axes,
     figure9_data,
+    isolated_points,
     period_limits,
 )
 from aerostat_gym.analysis.modes import wind_sweep
@@ -184,3 +185,26 @@ def test_two_mode_pitch_fit_at_and_above_nyquist(dt, pitch_ok):
         assert fast.zeta == pytest.approx(0.35, abs=0.01)
     else:
         assert math.isnan(fast.period) and "below the sampling's shortest" in fast.reason
+
+
+def test_isolated_points_are_the_values_with_no_finite_neighbour():
+    v = np.array([1.0, np.nan, 2.0, 3.0, np.nan, 4.0, np.nan, np.nan])
+    np.testing.assert_array_equal(isolated_points(v),
+                                  [True, False, False, False, False, True, False, False])
+
+
+def test_figure9_marks_a_mode_found_at_one_speed():
+    """A mode present at one speed of the sweep (a line through NaN neighbours draws nothing)
+    is drawn as a marker at its value, in its curve's colour, and adds no legend entry."""
+    data = {"wind_speed_m_s": [0.0, 5.0, 10.0],
+            "long": {"pendulum": {"period_s": [None, 41.5, None], "zeta": [None, 0.12, None]}},
+            "lat": {"pendulum": {"period_s": [80.0, 81.0, 82.0], "zeta": [0.1, 0.2, 0.3]}}}
+    _, axes = figure9_axes(data)
+    for row, value in ((0, 41.5), (1, 0.12)):
+        marked = [line for line in axes[row, 0].get_lines() if line.get_marker() == "o"]
+        assert len(marked) == 1
+        assert list(marked[0].get_xdata()) == [5.0] and list(marked[0].get_ydata()) == [value]
+        assert marked[0].get_color() == axes[row, 0].get_lines()[0].get_color()
+    assert not [line for line in axes[0, 1].get_lines()
+                if line.get_marker() == "o" and len(line.get_xdata())]
+    assert _legend(axes[0, 0]) == ["pendulum"]

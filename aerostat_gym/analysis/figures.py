@@ -358,6 +358,15 @@ def _legend_label(label: str, periods: np.ndarray, top: float) -> str:
     return label if longest <= top else f"{label} (to {longest:.0f} s, off scale)"
 
 
+def isolated_points(values: np.ndarray) -> np.ndarray:
+    """Mask of the finite values whose neighbours on the speed grid are both missing (NaN or
+    off the grid's ends): a mode found at one speed only, which a line cannot show."""
+    ok = np.isfinite(values)
+    before = np.concatenate([[False], ok[:-1]])
+    after = np.concatenate([ok[1:], [False]])
+    return ok & ~before & ~after
+
+
 def figure9_axes(data: dict, title: str = ""):
     """The Figure 9 plot of :func:`plot_figure9` as (figure, 2 x 2 axes), not yet saved."""
     plt = _pyplot()
@@ -374,8 +383,11 @@ def figure9_axes(data: dict, title: str = ""):
             zeta = np.array([np.nan if v is None else v for v in curves["zeta"]])
             kw = {"color": colours[k % 5], "ls": styles[k % 5],
                   "label": _legend_label(label, per, period_axis[1])}
-            axes[0, col].plot(u, per, **kw)
-            axes[1, col].plot(u, zeta, **kw)
+            for ax, values in ((axes[0, col], per), (axes[1, col], zeta)):
+                ax.plot(u, values, **kw)
+                alone = isolated_points(values)  # a line through NaN neighbours draws nothing
+                ax.plot(u[alone], values[alone], ls="none", marker="o", ms=4,
+                        color=kw["color"])
         axes[0, col].set_title(f"{name} Modes")
         axes[0, col].set_ylabel(r"period, $\tau_n$ (s)")
         axes[1, col].set_ylabel(r"damping ratio, $\zeta$")
