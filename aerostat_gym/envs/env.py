@@ -279,6 +279,13 @@ class TetheredAerostatEnv(gym.Env):
       the winch off the origin (``tether.anchor_position``) the start's swing pivots on the
       winch (it pivoted on the origin, which stretched the tether and broke it on the first
       step); with the winch at the origin, as in every registered task, starts are unchanged.
+    - v0 (aerostat-gym 0.7.14; the registered tasks, their seeded episodes and every stored
+      evaluation unchanged): ``overrides`` and a ``params`` built with ``Params.replace`` meet
+      the loader's plausibility bounds at make (``ImplausibleParameterError``; were accepted:
+      an RK4 step past its stability bound, a tether density in g/cm^3); an aerostat whose
+      net lift only just exceeds its tether's weight trims in light wind (failed after 6-24 s
+      at 0.5-3 m/s), and a trim that would hang the tether below the ground is refused naming
+      the weights; an off-grid reset speed's trim is remembered by the environment.
     """
 
     metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
