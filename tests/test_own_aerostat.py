@@ -45,6 +45,7 @@ from aerostat_gym.analysis.linear import ACTUATORS, U_FREE, input_jacobian
 from aerostat_gym.analysis.modes import analyse, wind_sweep
 from aerostat_gym.analysis.reference import (
     THEORY_TOLERANCE_PCT,
+    closed_form_periods,
     format_table2,
     table2,
     veering_allowance,
@@ -623,6 +624,40 @@ def test_mode_labels_do_not_depend_on_the_grid():
         curves = [np.interp(shared, sw.values, sw.curve("lat", label, "wn")) for sw in sweeps]
         for c in curves[1:]:
             np.testing.assert_allclose(c, curves[0], rtol=1e-6)
+
+
+def test_still_air_pendulum_keeps_its_name_on_a_long_grid(tmp_path, capsys):
+    """0.004 x the baseline on 1000 m in 8 elements (the audit's 1906 m in 25 shows the same):
+    in wind the light tether's drag adds real eigenvalues classed "pendulum" beside the swing,
+    at every windy speed, and MAC continuity carries the still-air swing into one of them. On
+    0:30:5 those lanes outnumbered it: the U = 0 lateral pendulum was "pendulum (3)", "-" in the
+    table and Figure 9. On 0:30:5 and 0:5:5 the table's U = 0 lateral pendulum is now one period
+    (rel 1e-9) within the Table 2 band (2 %) of the still-air closed form (110.42 s; linear
+    110.45 s), and Figure 9 carries it; at every speed the plain track holds the label's
+    lowest-frequency mode, the one Table 2 reads (ModalAnalysis.find)."""
+    p = scale_aerostat(load_params(), 0.004, 1000.0, 8, -0.34)
+    cfg = tmp_path / "long_light.toml"
+    cfg.write_text(dumps_toml(p))
+    still_air = []
+    for grid in ("0:30:5", "0:5:5"):
+        out = json.loads(_run(capsys, ["stability", "--config", str(cfg), "--wind", grid, "--json"]))
+        lateral = [r for r in out["modes"] if r["set"] == "lat" and r["label"] == "pendulum"]
+        assert [r["wind_speed_m_s"] for r in lateral] == out["figure9"]["wind_speed_m_s"], grid
+        for r in lateral:  # the plain track holds the label's slowest mode, Table 2's
+            family = [m["wn_rad_s"] for m in out["modes"] if m["set"] == "lat"
+                      and m["label"].startswith("pendulum")
+                      and m["wind_speed_m_s"] == r["wind_speed_m_s"]]
+            assert r["wn_rad_s"] == min(family), (grid, r["wind_speed_m_s"])
+        assert lateral[0]["oscillatory"], grid
+        assert out["figure9"]["lat"]["pendulum"]["period_s"][0] == lateral[0]["period_s"]
+        still_air.append(lateral[0]["period_s"])
+        row = _run(capsys, ["stability", "--config", str(cfg), "--wind", grid]).split(
+            "Lateral modes")[1].splitlines()[2]
+        assert row.split()[:2] == ["0.00", f"{lateral[0]['period_s']:.2f}"], (grid, row)
+    assert still_air[0] == pytest.approx(still_air[1], rel=1e-9)
+    closed = closed_form_periods(p)["lat_pendulum"]
+    assert abs(still_air[0] / closed - 1) * 100 <= THEORY_TOLERANCE_PCT["lat_pendulum"], (
+        still_air, closed)
 
 
 def test_turbulence_field_sized_from_the_configuration():

@@ -38,8 +38,9 @@ def large_hull():
 
 @pytest.fixture(scope="module")
 def divergent_sweep():
-    # 0 m/s first: there the lateral pendulum swings, so at 10 m/s the growing real eigenvalue
-    # is a second "pendulum" track, "pendulum (2)", which the table has no column for
+    # 0 m/s first: there the lateral pendulum swings; at 10 m/s it splits into real
+    # eigenvalues and the slowest, the growing one, is on the plain "pendulum" track (the
+    # label's lowest-frequency mode at each speed, Table 2's; it was "pendulum (2)" before 0.7.14)
     return wind_sweep(load_params().replace(**DIVERGENT), [0.0, 10.0])
 
 
@@ -57,7 +58,7 @@ def test_unstable_real_mode_is_named_with_its_eigenvalue(divergent_sweep):
     named with its track, speed and eigenvalue; a real mode reports no period."""
     (entry,) = divergent_sweep.unstable()
     lam_lat = np.linalg.eigvals(divergent_sweep.analyses[1].decoupled.A_lat)
-    assert (entry["set"], entry["label"], entry["values"]) == ("lat", "pendulum (2)", [10.0])
+    assert (entry["set"], entry["label"], entry["values"]) == ("lat", "pendulum", [10.0])
     assert entry["worst"].eigenvalue.real == pytest.approx(float(lam_lat.real.max()), rel=1e-9)
     assert entry["worst"].eigenvalue.real == pytest.approx(DIVERGENT_RATE_10, rel=1e-4)
     row = entry["worst"].row()
@@ -66,17 +67,19 @@ def test_unstable_real_mode_is_named_with_its_eigenvalue(divergent_sweep):
     assert entry["worst"].describe() == "real (non-oscillatory), GROWS with time constant 26.3 s"
 
 
-def test_stability_table_names_the_mode_it_has_no_column_for(capsys):
+def test_stability_table_names_the_unstable_mode(capsys):
+    """The UNSTABLE line names the track, the speed and the eigenvalue, and the table's
+    lateral pendulum column shows the growing root at 10 m/s as real with zeta -1."""
     assert main(["stability", "--set", "hull.eta_k=0.6", "--wind", "0:10:10"]) == 0
     text = capsys.readouterr().out
     assert "all modes stable at every speed: False" in text
-    assert ("UNSTABLE lateral pendulum (2) at U = 10 m/s; fastest at 10 m/s: lambda = +0.03798 "
+    assert ("UNSTABLE lateral pendulum at U = 10 m/s; fastest at 10 m/s: lambda = +0.03798 "
             "1/s, real (non-oscillatory), GROWS with time constant 26.3 s") in text
     assert main(["stability", "--set", "hull.eta_k=0.6", "--wind", "0:10:10", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     (unstable,) = out["unstable_modes"]
     assert (unstable["label"], unstable["wind_speeds_m_s"], unstable["period_s"]) == (
-        "pendulum (2)", [10.0], None)
+        "pendulum", [10.0], None)
     real_rows = [r for r in out["modes"] if not r["oscillatory"]]
     assert len(real_rows) == 6 and all(r["period_s"] is None for r in real_rows)
 

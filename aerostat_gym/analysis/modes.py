@@ -410,7 +410,8 @@ class ModalAnalysis:
         return all(m.stable for m in self.long + self.lat)
 
     def find(self, subset: str, label: str) -> Mode | None:
-        """Lowest-frequency mode of ``subset`` with this label."""
+        """Lowest-frequency mode of ``subset`` with this label (the one a sweep's plain track
+        holds at this speed, :func:`_lowest_into_plain_lane`)."""
         return next((m for m in getattr(self, subset) if m.label == label), None)
 
 
@@ -521,6 +522,64 @@ def _lanes_of_label(tables: list[list[Mode]], ctx_list: list[ModeContext], label
     return lanes
 
 
+def _mean_wn(lane: list[Mode | None]) -> float:
+    """Mean natural frequency of the modes a lane holds [rad/s]."""
+    return float(np.mean([m.wn for m in lane if m is not None]))
+
+
+def _rank_lanes(lanes: list[list[Mode | None]]) -> list[list[Mode | None]]:
+    """The non-empty lanes, the most present first (ties: the lower mean frequency first)."""
+    held = [lane for lane in lanes if any(m is not None for m in lane)]
+    return sorted(held, key=lambda lane: (-sum(m is not None for m in lane), _mean_wn(lane)))
+
+
+def _lowest_into_plain_lane(lanes: list[list[Mode | None]]) -> list[list[Mode | None]]:
+    """Put, at every point, the label's lowest-frequency mode in the plain lane (``lanes[0]``),
+    the mode :meth:`ModalAnalysis.find` returns there (Table 2's); the numbered lanes re-ranked.
+
+    Notes
+    -----
+    MAC continuity alone can leave the plain lane empty where the label's mode exists, or hold
+    another of its modes there. In wind, a long light tether's drag makes the aerostat creep
+    back without swinging: a family of overdamped "pendulum" roots beside the swinging mode.
+    Continuity may carry the still-air swing into one of those branches, and they can be the
+    most present lanes, so the still-air pendulum lost the plain name to a lane that starts at
+    the first windy speed (a 0.004x aerostat on 1906 m: "pendulum (3)" on a 0-30 m/s grid, the
+    plain one on 0-5 m/s), and the stability table showed nothing at 0 m/s. The rule reads one
+    point alone, so the plain track never depends on the grid and names the mode Table 2 reads.
+    The displaced mode (or gap) takes the moved mode's place in its lane, so every mode stays
+    on one track.
+    """
+    plain, others = lanes[0], lanes[1:]
+    for step, mode in enumerate(plain):
+        held = [lane for lane in others if lane[step] is not None]
+        if not held:
+            continue
+        donor = min(held, key=lambda lane: lane[step].wn)
+        if mode is None or donor[step].wn < mode.wn:
+            plain[step], donor[step] = donor[step], mode
+    return [plain] + _rank_lanes(others)
+
+
+def _ranked_lanes_of_label(tables: list[list[Mode]], ctx_list: list[ModeContext],
+                           label: str) -> list[list[Mode | None]]:
+    """The lanes of ``label`` (:func:`_lanes_of_label`), the plain one first.
+
+    Notes
+    -----
+    The most present lane is the plain one, and for the aerostat's own labels it holds the
+    label's lowest-frequency mode at each point (:func:`_lowest_into_plain_lane`). Tether
+    labels keep MAC continuity's lanes: they are read from sign changes along the tether,
+    which a high harmonic can fool (3600 m^3 on 1000 m at 20 m/s: a 0.42 s, 100 % tether mode
+    counts as the first harmonic, whose own track turns into a real eigenvalue there as its
+    damping passes 1).
+    """
+    lanes = _rank_lanes(_lanes_of_label(tables, ctx_list, label))
+    if label in AEROSTAT_MODES[ctx_list[0].subset]:
+        return _lowest_into_plain_lane(lanes)
+    return lanes
+
+
 def label_tracks(tables: list[list[Mode]], ctx_list: list[ModeContext]
                  ) -> list[tuple[str, list]]:
     """Tracks of a sweep, labelled by eigenvector shape at every point.
@@ -532,17 +591,16 @@ def label_tracks(tables: list[list[Mode]], ctx_list: list[ModeContext]
     a mode at a speed never depends on the other speeds of the grid. A track is the sequence of
     the modes carrying one label; where several modes share a label at a point, MAC continuity
     sorts them into lanes, the most present keeping the plain label and the others getting
-    (2), (3). Tracks are returned in order of mean natural frequency.
+    (2), (3), except that for an aerostat label (pendulum, pitching, ...) the plain track holds
+    the label's lowest-frequency mode at every point, Table 2's (:func:`_ranked_lanes_of_label`):
+    a still-air swing never drops to a numbered track behind overdamped branches of its label,
+    whatever the grid. Tracks are returned in order of mean natural frequency.
     """
-    def mean_wn(t):
-        return float(np.mean([m.wn for m in t if m is not None]))
-
     out = []
     for label in dict.fromkeys(m.label for table in tables for m in table):
-        lanes = _lanes_of_label(tables, ctx_list, label)
-        lanes.sort(key=lambda t: (-sum(m is not None for m in t), mean_wn(t)))
+        lanes = _ranked_lanes_of_label(tables, ctx_list, label)
         out += [(label if k == 0 else f"{label} ({k + 1})", lane) for k, lane in enumerate(lanes)]
-    return sorted(out, key=lambda item: mean_wn(item[1]))
+    return sorted(out, key=lambda item: _mean_wn(item[1]))
 
 
 def sweep_analyses(analyses: list[ModalAnalysis], params_list: list[Params], values,
