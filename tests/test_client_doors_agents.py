@@ -363,3 +363,15 @@ def test_dropping_a_stateful_policys_state_warns_once(name):
     with warnings.catch_warnings():
         warnings.simplefilter("error", DroppedStateWarning)
         policy.predict(obs)  # once per policy
+
+
+def test_demo_takes_a_baseline_it_already_runs_and_prints_every_scenario(tmp_path, capsys):
+    """``demo --policy lqr``: the help offers the baselines' names, and lqr is already in the
+    comparison; it runs once (was "a policy is listed twice" after the stability summary).
+    The console shows every scenario of the suite (the tiny suite: recover and gusty), each
+    with passive and lqr at every speed, as evaluate does."""
+    assert main(["demo", "--policy", "lqr", "--out", str(tmp_path / "demo")]) == 0
+    out = capsys.readouterr().out
+    assert "\nrecover:\n" in out and "\ngusty:\n" in out
+    rows = [line.split("|")[1:3] for line in out.splitlines() if line.startswith("| 10 |")]
+    assert [policy.strip() for _, policy in rows] == ["passive", "lqr", "passive", "lqr"]

@@ -515,6 +515,16 @@ def test_8_cache_holds_at_most_max_cached_banks():
     (["wind", "--duration", "1e9"], "--duration", "1e+09"),
     (["wind", "--ensemble", "5000"], "--ensemble", "5000"),
     (["wind", "--seed", "-1"], "--seed", "-1"),
+    # a range that starts with a minus sign is the range check's, not argparse's "expected one
+    # argument"
+    (["stability", "--wind", "-5:10:1"], "--wind", "-5:10:1"),
+    (["sensitivity", "--wind", "-2:10:2"], "--wind", "-2:10:2"),
+    (["montecarlo", "--wind", "-1:5:1"], "--wind", "-1:5:1"),
+    # --plot is checked before the work: a folder it cannot write, or nothing to plot
+    (["stability", "--wind", "10", "--plot", "/proc/nope"], "--plot", "/proc/nope"),
+    (["wind", "--plot", "/proc/nope/x.png"], "--plot", "/proc/nope/x.png"),
+    (["wind", "--preset", "none", "--plot", "x.png"], "--plot", "x.png"),
+    (["wind", "--config", "tcom_32m", "--plot", "x.png"], "--plot", "x.png"),
 ])
 def test_9_bad_cli_values_are_one_line_on_stderr_with_status_2(capsys, argv, option, value):
     code, out, err = _cli(capsys, *argv)

@@ -13,6 +13,7 @@ One module per group of commands (``model``, ``wind``, ``stability``, ``agents``
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
 from pathlib import Path
@@ -86,12 +87,29 @@ def one_line_warnings(command: str):
     return show
 
 
+def _attach_dashed_values(argv: list[str]) -> list[str]:
+    """``--wind -5:10:1`` as ``--wind=-5:10:1``: argparse takes a value that starts with a dash
+    and is not a plain negative number for an option, and would answer "expected one argument"
+    instead of the range check's message naming the value."""
+    out: list[str] = []
+    for arg in argv:
+        if out and out[-1] == "--wind" and arg[:1] == "-" and arg[1:2].isdigit():
+            out[-1] = f"--wind={arg}"
+        else:
+            out.append(arg)
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
+    argv = _attach_dashed_values(sys.argv[1:] if argv is None else list(argv))
     args = build_parser().parse_args(argv)
     with warnings.catch_warnings():
         warnings.showwarning = one_line_warnings(args.command)
         try:
             return args.func(args)
+        except BrokenPipeError:  # the reader closed the pipe (| head): nothing to report
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            return 0
         except (ParameterError, ValueError, RuntimeError, OSError) as exc:
             print(f"aerostat-gym {args.command}: error: {exc}", file=sys.stderr)
             return 2

@@ -135,7 +135,8 @@ def add_demo_parser(sub) -> None:
     p.add_argument("--wind", type=nonneg_float, default=10.0,
                    help="wind speed of the summary [m/s]")
     p.add_argument("--policy", default="shipped",
-                   help="policy to compare with the baselines: shipped or PATH.zip")
+                   help="policy to compare with the baselines passive and lqr: shipped (the "
+                   "default), another baseline's name or PATH.zip")
     p.add_argument("--out", default="runs/demo", help="report directory")
     p.add_argument("--suite", choices=list(SUITES), default="tiny", help="evaluation suite")
     p.add_argument("--speeds", type=nonneg_float, nargs="+", metavar="U",
@@ -152,7 +153,7 @@ def _demo_command(args) -> int:
     policies = ["passive", "lqr"]
     # the shipped policy was trained on the baseline aerostat: on another one it is left out
     shipped_left_out = args.policy == "shipped" and params != load_params()
-    if not shipped_left_out:
+    if not shipped_left_out and args.policy not in policies:
         policies.append(args.policy)
     _check_suite_winds(args.suite, args.speeds, params)
     out = output_dir(args.out)
@@ -166,8 +167,8 @@ def _demo_command(args) -> int:
     md = write_report(results, out, "aerostat-gym demo",
                       "aerostat-gym demo " + " ".join(sys.argv[1:]),
                       preamble=["## Trim and linear stability", "", "```", *summary, "```", ""])
-    print()
-    print(comparison_table(results, "recover"))
+    for scenario in results[0]["scenarios"]:
+        print(f"\n{scenario}:\n{comparison_table(results, scenario)}")
     print(f"\nreport (Markdown, plots, JSON): {md} ({time.perf_counter() - t0:.0f} s)")
     return 0
 

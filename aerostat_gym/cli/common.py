@@ -104,6 +104,14 @@ def output_dir(path: str, option: str = "--out") -> Path:
     return out
 
 
+def output_file(path: str, option: str) -> Path:
+    """A file a command will write: its folder created and checked writable before the
+    command's work (:func:`output_dir`)."""
+    out = Path(path)
+    output_dir(str(out.parent), f"{option} {path}: its folder")
+    return out
+
+
 def config_source(text: str) -> str:
     """argparse type of ``--config``: a shipped configuration's name or an existing file."""
     if text in shipped_configs() or Path(text).is_file():

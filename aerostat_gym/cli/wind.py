@@ -33,6 +33,7 @@ from ..wind.stats import (
 from .common import (
     add_config,
     nonneg_float,
+    output_file,
     params_from_args,
     positive_float,
     positive_int,
@@ -104,12 +105,25 @@ def _config(args, params):
     return cfg.replace(**changes) if changes else cfg
 
 
+def _check_plot(args, cfg) -> None:
+    """--plot needs a turbulent field and a folder it can write, checked before the field is
+    built."""
+    if cfg.is_off:
+        where = (" (the parameter file's wind.turbulence is 'none')"
+                 if (args.preset or (FROM_CONFIG if args.config else "")) == FROM_CONFIG else "")
+        raise ValueError(f"--plot {args.plot}: no turbulence to plot{where}; choose a class "
+                         f"with --preset ({', '.join(p for p in PRESETS if p != 'none')})")
+    output_file(args.plot, "--plot")
+
+
 def wind_command(args) -> int:
     """Run ``aerostat-gym wind``; returns the exit status (2 on invalid input)."""
     try:
         _check_record(args)
         params = params_from_args(args)
         cfg = _config(args, params)
+        if args.plot:
+            _check_plot(args, cfg)
         w = params.wind
         mean = {"profile": args.profile or w.profile, "speed": args.speed,
                 "reference_height": args.reference_height or w.reference_height,
@@ -136,7 +150,7 @@ def wind_command(args) -> int:
         out.update(realised_statistics(cfg, wp, fields))
         out["air_inertia"] = _air_inertia(params, cfg, wp, wf, args.duration)
     print(json.dumps(out, indent=2) if args.json else _table(out))
-    if args.plot and not cfg.is_off:
+    if args.plot:
         _plot(args.plot, cfg, wp, fields)
     return 0
 
