@@ -416,3 +416,17 @@ def test_tune_two_trials_write_the_table(ray_session, tmp_path, capsys):
     assert task == "TetheredAerostatDamping-v0" and project["eval_suite"] == "damping"
     assert best_hp["learning_rate"] == json.loads(trials[0]["config"])["learning_rate"]
     assert best_hp["n_timesteps"] == 128 and best_hp["n_steps"] == 64
+
+
+def test_the_shipped_search_space_fits_the_shipped_base_file():
+    """``tune --algo ppo`` without --space reads the shipped space, keyed by the task of the
+    shipped ppo.yml (it was keyed by the 0.3 base's task and refused); an algorithm with no
+    shipped space is named."""
+    from aerostat_gym.cli import build_parser
+    from aerostat_gym.cli.scale import setup_from_args
+
+    setup = setup_from_args(build_parser().parse_args(["tune", "--algo", "ppo"]))
+    assert setup.task == load_hyperparams("ppo")[0] == "TetheredAerostatRealistic-v0"
+    assert setup.space["gamma"] == {"uniform": [0.98, 0.998]}
+    with pytest.raises(ValueError, match="no search space ships for sac; pass --space"):
+        setup_from_args(build_parser().parse_args(["tune", "--algo", "sac"]))

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..agents.train import ALGOS, load_hyperparams
+from ..resources import shipped_path
 
 # the stability commands' parsing of --wind, --config and --set, shared rather than copied
 from ..scale.bench import format_throughput, throughput
@@ -192,8 +193,9 @@ def add_tune_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--algo", choices=ALGOS, default="ppo", help="Stable-Baselines3 algorithm")
     p.add_argument("--hyperparams", metavar="YAML",
                    help="base hyperparameter file (default: the shipped hyperparams/ALGO.yml)")
-    p.add_argument("--space", required=True,
-                   help="search space YAML, keyed by the base file's task id")
+    p.add_argument("--space", metavar="YAML",
+                   help="search space YAML, keyed by the base file's task id (default: the "
+                   "shipped hyperparams/ALGO_space.yml, for ppo)")
     p.add_argument("--seeds", type=seed_int, nargs="+", default=[0, 1, 2, 3, 4],
                    help="training seeds; every configuration runs each (default 0-4)")
     p.add_argument("--configs", type=positive_int, default=4, help="configurations to try (default 4)")
@@ -215,10 +217,19 @@ def add_tune_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print the results as JSON")
 
 
+def shipped_space(algo: str) -> Path:
+    """The shipped search space of ``algo`` (``hyperparams/ALGO_space.yml``), for the shipped
+    base file's task."""
+    try:
+        return shipped_path("hyperparams", f"{algo}_space.yml")
+    except FileNotFoundError:
+        raise ValueError(f"--space: no search space ships for {algo}; pass --space YAML") from None
+
+
 def setup_from_args(args: argparse.Namespace) -> TrialSetup:
     """The shared trial setup from the command line (reads both YAML files)."""
     task, base, project = load_hyperparams(args.algo, args.hyperparams)
-    space = load_space(args.space, task)
+    space = load_space(args.space or shipped_space(args.algo), task)
     timesteps = int(args.timesteps or base.get("n_timesteps", 1e6))
     if timesteps < 1 or args.threads < 1:
         raise ValueError(f"--timesteps and --threads must be >= 1, got {timesteps}, {args.threads}")
