@@ -533,6 +533,12 @@ def _rank_lanes(lanes: list[list[Mode | None]]) -> list[list[Mode | None]]:
     return sorted(held, key=lambda lane: (-sum(m is not None for m in lane), _mean_wn(lane)))
 
 
+def _slower(a: Mode, b: Mode) -> bool:
+    """Whether mode ``a`` has the lower natural frequency; two neutral modes (the split double
+    zero of the free yaw at zero wind, whose sizes and signs are rounding) are a tie."""
+    return a.wn < b.wn and not (a.neutral and b.neutral)
+
+
 def _lowest_into_plain_lane(lanes: list[list[Mode | None]]) -> list[list[Mode | None]]:
     """Put, at every point, the label's lowest-frequency mode in the plain lane (``lanes[0]``),
     the mode :meth:`ModalAnalysis.find` returns there (Table 2's); the numbered lanes re-ranked.
@@ -556,7 +562,7 @@ def _lowest_into_plain_lane(lanes: list[list[Mode | None]]) -> list[list[Mode | 
         if not held:
             continue
         donor = min(held, key=lambda lane: lane[step].wn)
-        if mode is None or donor[step].wn < mode.wn:
+        if mode is None or _slower(donor[step], mode):
             plain[step], donor[step] = donor[step], mode
     return [plain] + _rank_lanes(others)
 
