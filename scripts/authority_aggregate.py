@@ -24,6 +24,7 @@ from aerostat_gym.agents.authority import DESIGNS, design_result
 from aerostat_gym.agents.policies import BASELINES
 from aerostat_gym.agents.protocol import aggregate, json_safe
 from aerostat_gym.agents.report import load_results
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import load_params
 
 
@@ -43,7 +44,7 @@ def table(agg: dict, designs: list[str], baselines: list[str]) -> str:
 
 
 def main(argv=None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("report_json", nargs="+", help="report.json of the baselines' evaluate runs "
                     "on the report suite")
     ap.add_argument("--json", default=None, help="write the aggregate rows to this JSON file")
@@ -99,4 +100,4 @@ def main(argv=None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -28,11 +28,12 @@ from aerostat_gym.agents.authority import (
 )
 from aerostat_gym.agents.evaluate import REPORT_SEEDS
 from aerostat_gym.agents.protocol import json_safe
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import load_params
 
 
 def main(argv=None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--seeds", type=int, default=len(REPORT_SEEDS),
                     help="report seeds to run, from the first (default all 20)")
     ap.add_argument("--json", default=None, help="write the sweep to this JSON file")
@@ -62,4 +63,4 @@ def main(argv=None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -27,11 +27,12 @@ from aerostat_gym.agents.command_path import (
     study_markdown,
 )
 from aerostat_gym.agents.protocol import json_safe
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import load_params
 
 
 def main(argv=None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--base", default="modal_lqg", help="the policy to shape (default modal_lqg)")
     ap.add_argument("--lowpass", type=float, nargs="+", default=[0.0, 1.0, 2.0, 3.0],
                     help="low-pass time constants [s] (0: none; default 0 1 2 3)")
@@ -65,4 +66,4 @@ def main(argv=None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -30,6 +30,7 @@ from aerostat_gym.agents.evaluate import SENSOR_NOISE, suite_result
 from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.agents.report import load_results, policy_labels
 from aerostat_gym.agents.residual import ShapedPolicy
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import load_params
 
 #: (scenario, wind speed, metric) of the printed key-cell columns.
@@ -47,7 +48,7 @@ def key_cells(result: dict) -> list[float]:
 
 
 def main(argv=None) -> list[dict]:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--policy", action="append", default=None, metavar="NAME_OR_PATH",
                     help="a policy for load_policy (repeatable; default: shipped)")
     ap.add_argument("--deadband", type=float, default=0.05,
@@ -107,4 +108,4 @@ def main(argv=None) -> list[dict]:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -22,6 +22,7 @@ import numpy as np
 
 import aerostat_gym  # noqa: F401  (registers the environment)
 from aerostat_gym.bench.soak import STRESS_PERTURBATION
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.envs.batch import held_wind_top
 from aerostat_gym.params import TETHER_DRAG_REFERENCE_SPEED, load_params, tether_drag_step
 from aerostat_gym.registration import ENV_ID
@@ -57,7 +58,7 @@ def run(p, seed: int) -> tuple[Counter, tuple[float, float]]:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--seed", type=int, default=7, help="seed of the generated aerostats")
     ap.add_argument("--count", type=int, default=16, help="aerostats to generate")
     args = ap.parse_args()
@@ -82,4 +83,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -26,6 +26,7 @@ from aerostat_gym.agents.evaluate import SENSOR_NOISE, episode_metrics, run_scen
 from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.agents.protocol_stats import paired_difference_ci
 from aerostat_gym.agents.returns import task_returns
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.envs.config import DEFAULT_WIND_RANGE
 
 TASK = "TetheredAerostatDamping-v0"
@@ -62,7 +63,7 @@ def evaluate(label, name):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=script_description(__doc__))
     p.add_argument("policies", nargs="+", help="NAME or LABEL=PATH")
     p.add_argument("--reference", default="shipped")
     p.add_argument("--json", default=None)
@@ -119,4 +120,4 @@ def table(results: dict, reference: str) -> str:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 
 from aerostat_gym.bench.moordyn_dynamic import format_report, run_dynamic_comparison
+from aerostat_gym.cli.common import run_script, script_description
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--quick", action="store_true", help="one short case (smoke run)")
     ap.add_argument("--cases", help="comma-separated case names (default: the whole table)")
     ap.add_argument("--variants", default="baseline",
@@ -41,4 +41,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(run_script(main))

@@ -14,11 +14,12 @@ import argparse
 
 from aerostat_gym.agents.pitch_check import check_markdown, linear_pitch_check
 from aerostat_gym.agents.report import emit_table
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import load_params
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--config", default=None, help="parameter TOML (default: the baseline)")
     ap.add_argument("--speeds", nargs="+", type=float, default=[5.0, 10.0, 15.0])
     ap.add_argument("--scenarios", nargs="+", default=["recover", "recover_small"])
@@ -31,4 +32,4 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -16,12 +16,13 @@ from __future__ import annotations
 import argparse
 
 from aerostat_gym.agents.pitch_check import pitch_fit_coverage
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import load_params
 from aerostat_gym.scaling import scale_aerostat
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--config", default=None, help="parameter TOML (default: the baseline)")
     ap.add_argument("--scale", nargs=2, type=float, metavar=("VOLUME_FACTOR", "TETHER_LENGTH"),
                     help="the configuration scaled by aerostat_gym.scaling.scale_aerostat")
@@ -40,4 +41,4 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

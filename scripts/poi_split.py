@@ -20,10 +20,11 @@ import argparse
 
 from aerostat_gym.agents.poi_split import lost_by_all, lost_markdown, poi_split, split_markdown
 from aerostat_gym.agents.report import emit_table, load_results
+from aerostat_gym.cli.common import run_script, script_description
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("report_json", nargs="+", help="report.json of evaluate runs on one suite")
     ap.add_argument("--x", nargs="+", required=True, help="labels of the improving policies")
     ap.add_argument("--y", nargs="+", required=True, help="labels of the policies compared to")
@@ -46,4 +47,4 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -13,10 +13,11 @@ import argparse
 import json
 
 from aerostat_gym.agents.protocol_summary import condensed
+from aerostat_gym.cli.common import run_script, script_description
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("protocol_json", help="protocol.json written by aerostat-gym evaluate")
     args = ap.parse_args(argv)
     with open(args.protocol_json) as fh:
@@ -24,4 +25,4 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -7,18 +7,22 @@ Usage: python scripts/render_frame.py [--out docs/img/frame.png] [--seed 0] [--s
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import gymnasium as gym
 import matplotlib.pyplot as plt
 import numpy as np
 
 import aerostat_gym  # noqa: F401  (registers the environment)
+from aerostat_gym.cli.common import run_script, script_description
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+    ap = argparse.ArgumentParser(description=script_description(__doc__),
                                  formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    ap.add_argument("--out", default="docs/img/frame.png", help="PNG file to write")
+    ap.add_argument("--out", default=str(Path(__file__).resolve().parent.parent / "docs" / "img"
+                                         / "frame.png"),
+                    help="PNG file to write (default: the README's docs/img/frame.png)")
     ap.add_argument("--seed", type=int, default=0, help="episode seed")
     ap.add_argument("--steps", type=int, default=60, help="braked-winch steps before the frame")
     args = ap.parse_args(argv)
@@ -32,4 +36,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run_script(main))

@@ -14,11 +14,11 @@ from __future__ import annotations
 import argparse
 
 from aerostat_gym.analysis.figures import FIG8_VARIABLES, write_figure8
-from aerostat_gym.cli.common import add_config, params_from_args
+from aerostat_gym.cli.common import add_config, params_from_args, run_script, script_description
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--out", required=True, help="output folder")
     add_config(ap, json=False)
     args = ap.parse_args(argv)
@@ -37,4 +37,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run_script(main))

@@ -20,11 +20,11 @@ from aerostat_gym.analysis.sensitivity import (
     lateral_pendulum_fixes,
     sensitivity_table,
 )
-from aerostat_gym.cli.common import add_config, params_from_args
+from aerostat_gym.cli.common import add_config, params_from_args, run_script, script_description
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--out", required=True, help="output folder")
     add_config(ap, json=False)
     ap.add_argument("--no-sensitivity", action="store_true", help="Table 2 only")
@@ -50,4 +50,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run_script(main))

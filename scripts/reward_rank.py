@@ -19,11 +19,12 @@ import argparse
 import json
 
 from aerostat_gym.agents.score_rank import rank_cells, rank_rows, summary
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import load_params
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+    ap = argparse.ArgumentParser(description=script_description(__doc__),
                                  formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--json", default=None, help="write the cells to this JSON file")
     args = ap.parse_args(argv)
@@ -46,4 +47,4 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -23,10 +23,11 @@ from aerostat_gym.agents.policies import BASELINES
 from aerostat_gym.agents.protocol import dumps
 from aerostat_gym.agents.report import load_results
 from aerostat_gym.agents.seed_spread import seed_spread, seed_spread_markdown
+from aerostat_gym.cli.common import run_script, script_description
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("report_json", nargs="+",
                     help="report.json of evaluate runs on the report suite")
     ap.add_argument("--seeds", nargs="+", required=True,
@@ -56,4 +57,4 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

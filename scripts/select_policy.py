@@ -24,10 +24,11 @@ from aerostat_gym.agents.policies import BASELINES
 from aerostat_gym.agents.protocol import dumps
 from aerostat_gym.agents.report import load_results
 from aerostat_gym.agents.selection import select, selection_markdown
+from aerostat_gym.cli.common import run_script, script_description
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("report_json", nargs="+", help="report.json of evaluate runs on the "
                     "validation suite")
     ap.add_argument("--candidates", nargs="+", required=True,
@@ -62,4 +63,4 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -22,6 +22,7 @@ import numpy as np
 
 import aerostat_gym  # noqa: F401  (registers the environment)
 from aerostat_gym.bench.soak import STRESS_PERTURBATION
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.registration import ENV_ID
 
 N_ENVS, STEPS = 8, 600
@@ -48,7 +49,7 @@ def episode_ends(length: float, elements: int, wind: float, overrides: dict) -> 
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--length", type=float, default=55.0, help="tether length [m]")
     ap.add_argument("--elements", type=int, default=24, help="tether elements")
     ap.add_argument("--winds", type=float, nargs="+", default=[5.0, 10.0, 15.0, 20.0, 25.0])
@@ -66,4 +67,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

@@ -16,14 +16,14 @@ from __future__ import annotations
 import argparse
 
 from aerostat_gym.agents.sideslip import OFFSETS_DEG, max_sideslip, yaw_curve
-from aerostat_gym.cli.common import add_config, params_from_args
+from aerostat_gym.cli.common import add_config, params_from_args, run_script, script_description
 
 FINS = {"configured": None,
         "flat, 16 deg": {"fins.post_stall": "flat", "fins.alpha_stall_deg": 16.0}}
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+    ap = argparse.ArgumentParser(description=script_description(__doc__),
                                  formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--episodes", type=int, default=20, help="episodes per cell")
     ap.add_argument("--air-inertia", action="store_true",
@@ -53,4 +53,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run_script(main))

@@ -7,13 +7,13 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from aerostat_gym.bench.soak import format_report, memory_check, run_soak
+from aerostat_gym.cli.common import run_script, script_description
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--steps", type=int, default=1_000_000, help="total env steps")
     ap.add_argument("--num-envs", type=int, default=8, help="vector env size per configuration")
     ap.add_argument("--seed", type=int, default=0)
@@ -33,4 +33,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(run_script(main))

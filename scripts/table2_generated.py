@@ -19,6 +19,7 @@ import numpy as np
 
 from aerostat_gym.analysis.reference import TABLE2, table2
 from aerostat_gym.analysis.trim import TrimError
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import ParameterError, load_params
 from aerostat_gym.scaling import scale_aerostat
 
@@ -31,7 +32,7 @@ def draw(rng: np.random.Generator) -> tuple[float, float, int, float]:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--seeds", type=int, nargs="+", default=[0])
     ap.add_argument("--count", type=int, default=200, help="aerostats per seed")
     args = ap.parse_args(argv)
@@ -71,4 +72,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run_script(main))

@@ -11,10 +11,11 @@ import argparse
 import json
 
 from aerostat_gym.agents.returns import format_returns, returns_table
+from aerostat_gym.cli.common import run_script, script_description
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+    ap = argparse.ArgumentParser(description=script_description(__doc__),
                                  formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--policy", action="append", help="policies (default: passive, lqr, shipped)")
     ap.add_argument("--json", action="store_true", help="print JSON rows instead of Markdown")
@@ -25,4 +26,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run_script(main))

@@ -15,6 +15,7 @@ import argparse
 import numpy as np
 
 from aerostat_gym.agents.intensity import air_inertia_force, realised_intensity
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import load_params
 from aerostat_gym.wind import build_wind
 from aerostat_gym.wind.presets import INTENSITY_MODELS
@@ -23,7 +24,7 @@ SPEEDS = (4.0, 8.0, 12.0, 16.0)
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--model", default="mil", choices=[m for m in INTENSITY_MODELS if m != "fixed"])
     args = ap.parse_args(argv)
@@ -54,4 +55,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run_script(main))

@@ -48,6 +48,7 @@ from aerostat_gym.agents.policies import (
     shaped_command,
 )
 from aerostat_gym.agents.protocol import json_safe
+from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.params import load_params
 
 SPEEDS = (5.0, 10.0, 15.0)
@@ -152,7 +153,7 @@ def _label(name: str) -> str:
 
 
 def main(argv=None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--swing", type=float, default=10.0, help="initial along-wind swing [m]")
     ap.add_argument("--policy", action="append", default=None, metavar="NAME_OR_PATH",
                     help="learned policy to add (repeatable; default: shipped)")
@@ -193,4 +194,4 @@ def main(argv=None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_script(main))

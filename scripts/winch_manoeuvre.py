@@ -17,12 +17,12 @@ import sys
 import numpy as np
 
 from aerostat_gym.analysis.manoeuvre import plot_manoeuvre, reel_manoeuvre
-from aerostat_gym.cli.common import add_config, params_from_args
+from aerostat_gym.cli.common import add_config, params_from_args, run_script, script_description
 from aerostat_gym.params import ParameterError
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--wind", type=float, default=10.0, help="mean wind speed [m/s]")
     ap.add_argument("--distance", type=float, default=50.0, help="reel-out distance [m]")
     ap.add_argument("--speed", type=float, default=None, help="reel speed [m/s] (default: limit)")
@@ -51,4 +51,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(run_script(main))

@@ -778,3 +778,26 @@ def test_memory_returns_after_closing_vector_envs():
 
     m = memory_check(n_envs=12, num_envs=2)
     assert m["delta_mb"] < 100.0
+
+
+@pytest.mark.parametrize("script, argv, text", [
+    ("reproduce_figure8.py", ["--config", "TYPO", "--out", "OUT"], "unknown section(s): x"),
+    ("task_returns.py", ["--policy", "nosuch"], "unknown policy 'nosuch'"),
+    ("protocol_readme.py", ["missing.json"], "No such file or directory: 'missing.json'"),
+])
+def test_9_scripts_refuse_bad_input_in_one_line(tmp_path, script, argv, text):
+    """The scripts run their main as the CLI runs a command (aerostat_gym.cli.common.run_script):
+    a refused input is one line on stderr naming it, exit status 2, no traceback."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    (tmp_path / "typo.toml").write_text("x = 1\n")
+    argv = [str(tmp_path / "typo.toml") if a == "TYPO" else str(tmp_path / "f8") if a == "OUT"
+            else a for a in argv]
+    path = Path(__file__).resolve().parent.parent / "scripts" / script
+    done = subprocess.run([sys.executable, str(path), *argv], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=300)
+    assert done.returncode == 2, done.stderr
+    line = done.stderr.strip()
+    assert line.startswith(f"{script}: error: ") and text in line and "\n" not in line, line

@@ -158,3 +158,23 @@ def params_from_args(args, **extra):
     over = parse_overrides(getattr(args, "set", []) or [])
     over.update({k: v for k, v in extra.items() if v is not None})
     return load_params(getattr(args, "config", None), over or None)
+
+
+# --- the scripts in scripts/ -----------------------------------------------------------------------
+
+
+def script_description(doc: str) -> str:
+    """A script's ``--help`` description: the first paragraph of its docstring, joined (its
+    first line alone stops mid-sentence)."""
+    return " ".join(doc.strip().split("\n\n")[0].split())
+
+
+def run_script(main) -> int:
+    """Run a script's ``main()`` as the CLI runs a command: a refused input (a ParameterError,
+    a PolicyError or another ValueError, a file that cannot be read) is one line on stderr and
+    exit status 2, not a traceback."""
+    try:
+        return int(main() or 0)
+    except (ValueError, RuntimeError, OSError) as exc:
+        print(f"{Path(sys.argv[0]).name}: error: {exc}", file=sys.stderr)
+        return 2
