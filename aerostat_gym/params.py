@@ -513,12 +513,13 @@ def hull_integral_warnings(p: Params) -> list[str]:
 #
 # A unit slip (MPa written as Pa, cm as m) passes every per-field check and the feasibility
 # checks, loads, and then fails every episode at step 0 far from its cause. The bounds below are
-# refused at the door (:func:`check_plausibility`, run by load_params on the file and its
-# overrides alike, and by the environment when it is made); values that are unusual but possible only warn (:func:`plausibility_warnings`,
-# a ParameterWarning). Every bound is generous: aerostats from 5 m to 70 m hulls, tethers from
-# 20 m to 5 km of Dyneema, Kevlar, Vectran, polyester or steel-armoured conductor cable all pass.
-# They are not checked by Params.replace / apply_overrides, so that studies may still move one
-# value past them on purpose (a weightless tether, RK4 past its stability bound) in the simulator.
+# refused at the door (:func:`check_plausibility`, run by load_params on the file and its overrides
+# alike, and by the environment when it is made); values that are unusual but possible only warn
+# (:func:`plausibility_warnings`, a ParameterWarning). Every bound is generous: aerostats from 5 m
+# to 70 m hulls, tethers from 20 m to 5 km of Dyneema, Kevlar, Vectran, polyester or steel-armoured
+# conductor cable all pass. They are not checked by Params.replace / apply_overrides, so that
+# studies may still move one value past them on purpose (a weightless tether, RK4 past its
+# stability bound) in the simulator.
 
 
 class ImplausibleParameterError(ParameterError):

@@ -640,7 +640,8 @@ def test_still_air_pendulum_keeps_its_name_on_a_long_grid(tmp_path, capsys):
     cfg.write_text(dumps_toml(p))
     still_air = []
     for grid in ("0:30:5", "0:5:5"):
-        out = json.loads(_run(capsys, ["stability", "--config", str(cfg), "--wind", grid, "--json"]))
+        out = json.loads(_run(capsys, ["stability", "--config", str(cfg), "--wind", grid,
+                                       "--json"]))
         lateral = [r for r in out["modes"] if r["set"] == "lat" and r["label"] == "pendulum"]
         assert [r["wind_speed_m_s"] for r in lateral] == out["figure9"]["wind_speed_m_s"], grid
         for r in lateral:  # the plain track holds the label's slowest mode, Table 2's

@@ -160,7 +160,7 @@ def params_from_args(args, **extra):
     return load_params(getattr(args, "config", None), over or None)
 
 
-# --- the scripts in scripts/ -----------------------------------------------------------------------
+# --- the scripts in scripts/ ---------------------------------------------------------------------
 
 
 def script_description(doc: str) -> str:

@@ -18,8 +18,6 @@ import numpy as np
 
 from ..agents.train import ALGOS, load_hyperparams
 from ..resources import shipped_path
-
-# the stability commands' parsing of --wind, --config and --set, shared rather than copied
 from ..scale.bench import format_throughput, throughput
 from ..scale.extra import require
 from ..scale.mc_report import summarize, write_outputs
@@ -27,6 +25,8 @@ from ..scale.montecarlo import PERIOD_KEYS, SWEEP_SPEEDS, evaluate_sample, run_r
 from ..scale.ranges import RANGE_SOURCES, estimated_ranges
 from ..scale.tune import SCHEDULERS, SEARCHERS, SearchOptions, TrialSetup, load_space, run_search
 from .common import positive_float, positive_int, seed_int
+
+# the stability commands' parsing of --wind, --config and --set, shared rather than copied
 from .stability import parse_speeds
 from .stability import stability_params as params_from_args
 
