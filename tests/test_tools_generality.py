@@ -211,3 +211,17 @@ def test_figure9_marks_a_mode_found_at_one_speed():
     assert not [line for line in axes[0, 1].get_lines()
                 if line.get_marker() == "o" and len(line.get_xdata())]
     assert _legend(axes[0, 0]) == ["pendulum"]
+
+
+def test_figure9_axes_shrink_to_a_7m_hull():
+    """A 7 m hull on 60 m (pendulums of at most 20.2 s longitudinal and 36.3 s lateral, under
+    half the paper's 50 s and 100 s): the axes come down to the round value 5 % above them,
+    25 s and 50 s, and every plotted period lies inside (on the paper's axes its pitching and
+    tether modes lay on the floor)."""
+    data, axes = _figure9(scale_aerostat(load_params(), (7.0 / 18.3) ** 3, 60.0, 5))
+    assert [axes[0, col].get_ylim() for col in (0, 1)] == [(0.0, 25.0), (0.0, 50.0)]
+    for col, subset in enumerate(("long", "lat")):
+        top = axes[0, col].get_ylim()[1]
+        for label, curves in data[subset].items():
+            if label != "yaw":
+                assert max(v for v in curves["period_s"] if v is not None) <= top, label

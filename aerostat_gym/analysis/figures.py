@@ -333,11 +333,16 @@ def _finite(curves) -> np.ndarray:
 
 
 def period_limits(curves, paper_top: float) -> tuple[float, float]:
-    """(0, top) of a period axis: the paper's top while every period fits under it, else a
-    round top 5 % above the longest period (a 35 m hull's 84-163 s pendulums)."""
+    """(0, top) of a period axis: the paper's top while the periods fill it (the longest
+    between half the top and the top), else a round top 5 % above the longest period, higher
+    for a larger aerostat's slower modes (a 35 m hull's 84-163 s pendulums), lower for a
+    smaller one's (a 7 m hull's, whose pitching and tether modes would lie on the floor of
+    the paper's axis)."""
     values = _finite(curves)
     longest = float(values.max()) if values.size else 0.0
-    return 0.0, paper_top if longest <= paper_top else _nice_ceiling(1.05 * longest)
+    if longest == 0.0 or 0.5 * paper_top <= longest <= paper_top:
+        return 0.0, paper_top
+    return 0.0, _nice_ceiling(1.05 * longest)
 
 
 def damping_limits(curves) -> tuple[float, float]:
