@@ -135,8 +135,8 @@ def add_demo_parser(sub) -> None:
     p.add_argument("--wind", type=nonneg_float, default=10.0,
                    help="wind speed of the summary [m/s]")
     p.add_argument("--policy", default="shipped",
-                   help="policy to compare with the baselines passive and lqr: shipped (the "
-                   "default), another baseline's name or PATH.zip")
+                   help="policy to compare with passive and lqr: shipped, a baseline's "
+                   "name or PATH.zip")
     p.add_argument("--out", default="runs/demo", help="report directory")
     p.add_argument("--suite", choices=list(SUITES), default="tiny", help="evaluation suite")
     p.add_argument("--speeds", type=nonneg_float, nargs="+", metavar="U",
