@@ -784,9 +784,10 @@ def plausibility_warnings(p: Params) -> list[str]:
     if p.hull.Cdc > HULL_CDC_WARN:
         out.append(f"hull.Cdc = {p.hull.Cdc:g} is above a circular cylinder's 0.3-1.2 "
                    f"(warning above {HULL_CDC_WARN:g})")
-    full = d.mass_per_length * p.winch.max_length * p.environment.g
+    line_weight = d.mass_per_length * p.environment.g  # [N/m]
+    full = line_weight * p.winch.max_length
     if d.net_lift <= full:
-        reach = d.net_lift / (d.mass_per_length * p.environment.g)
+        reach = d.net_lift / line_weight
         out.append(f"the net lift ({d.net_lift:.1f} N) does not exceed the weight of "
                    f"winch.max_length = {p.winch.max_length:g} m of tether ({full:.1f} N): paid "
                    f"out past {reach:.0f} m, the line rests on the wind's lift alone, and in "

@@ -92,11 +92,16 @@ def _check_record(args) -> None:
                          f"got {args.duration:g}")
 
 
+def _preset(args) -> str:
+    """The intensity class asked for: --preset, else the parameter file's with --config, else
+    moderate."""
+    return args.preset or (FROM_CONFIG if args.config else "moderate")
+
+
 def _config(args, params):
     """Preset with the command-line overrides, its field grid sized from the configuration
     (errors are ValueError with a clear message)."""
-    preset = args.preset or (FROM_CONFIG if args.config else "moderate")
-    cfg = sized_turbulence(params, preset)
+    cfg = sized_turbulence(params, _preset(args))
     changes = {k: v for k, v in (("model", args.model), ("method", args.method),
                                  ("reference_height", args.height),
                                  ("intensity_model", args.intensity_model)) if v is not None}
@@ -110,7 +115,7 @@ def _check_plot(args, cfg) -> None:
     built."""
     if cfg.is_off:
         where = (" (the parameter file's wind.turbulence is 'none')"
-                 if (args.preset or (FROM_CONFIG if args.config else "")) == FROM_CONFIG else "")
+                 if _preset(args) == FROM_CONFIG else "")
         raise ValueError(f"--plot {args.plot}: no turbulence to plot{where}; choose a class "
                          f"with --preset ({', '.join(p for p in PRESETS if p != 'none')})")
     output_file(args.plot, "--plot")
@@ -141,7 +146,7 @@ def wind_command(args) -> int:
     except (ValueError, TypeError) as e:
         print(f"aerostat-gym wind: error: {e}", file=sys.stderr)
         return 2
-    out = {"preset": args.preset or (FROM_CONFIG if args.config else "moderate"),
+    out = {"preset": _preset(args),
            "intensity_model": cfg.intensity_model, "model": cfg.model, "method": cfg.method,
            "seed": args.seed, "duration_s": args.duration, "mean_speed": args.speed,
            "field_shape": list(wf.shape), "generation_s": gen_s}
