@@ -65,6 +65,16 @@ MAX_OFF_GRID_TRIMS = 64
 _TRIMS: dict = {}
 
 
+def _remembered(cache: dict, key, make, limit: int):
+    """``cache[key]``, made by ``make()`` the first time; a cache holding ``limit`` entries
+    forgets its oldest first (dicts keep insertion order)."""
+    if key not in cache:
+        while len(cache) >= limit:
+            del cache[next(iter(cache))]
+        cache[key] = make()
+    return cache[key]
+
+
 class TrimTable:
     """Exact trims of the task's wind range, computed once per parameter set by continuation in
     wind speed and shared by every environment in the process.
@@ -94,12 +104,9 @@ class TrimTable:
         on_grid = np.isin(self.speeds, grid)
         self.draws = np.flatnonzero(on_grid) if on_grid.any() else np.array([0])
         key = (dumps_toml(params), tuple(self.speeds.tolist()))
-        if key not in _TRIMS:
-            while len(_TRIMS) >= MAX_CACHED_TRIMS:
-                del _TRIMS[next(iter(_TRIMS))]  # dicts keep insertion order: the oldest
-            _TRIMS[key] = _build_trims(params, self.speeds)
         # winch-end tension (the winch's load) and the largest (the tether's, top end) per speed
-        self.states, self.tensions, self.largest_tensions = _TRIMS[key]
+        self.states, self.tensions, self.largest_tensions = _remembered(
+            _TRIMS, key, lambda: _build_trims(params, self.speeds), MAX_CACHED_TRIMS)
         #: nominal trims at off-grid speeds already asked for (reset options), by speed
         self.off_grid: dict[float, np.ndarray] = {}
 
@@ -107,11 +114,8 @@ class TrimTable:
         """The nominal trim at an off-grid ``speed``, continued from the nearest table trim
         the first time and remembered (at most :data:`MAX_OFF_GRID_TRIMS` speeds, the oldest
         forgotten first), so an episode reset at the same speed again costs no trim."""
-        if speed not in self.off_grid:
-            while len(self.off_grid) >= MAX_OFF_GRID_TRIMS:
-                del self.off_grid[next(iter(self.off_grid))]
-            self.off_grid[speed] = _continued_trim(self.params, self, speed)
-        return self.off_grid[speed].copy()
+        return _remembered(self.off_grid, speed, lambda: _continued_trim(self.params, self, speed),
+                           MAX_OFF_GRID_TRIMS).copy()
 
     def equilibrium(self, k: int) -> Equilibrium:
         return Equilibrium(self.states[k].copy(), float(self.speeds[k]), self.params, 0.0, 0, {})
