@@ -430,6 +430,19 @@ def test_a_paid_out_tether_heavier_than_the_net_lift_needs_wind():
     assert s["elevation_at_winch_deg"] > 0 and s["min_tension_N"] > 0
 
 
+def test_a_paid_out_tether_heavier_than_the_net_lift_has_no_still_air_trim():
+    """Closed form: in still air the line hangs vertical and the winch carries net lift minus
+    the weight paid out, here 72.5 - 93.2 = -20.7 N: no flying equilibrium, refused before any
+    Newton iteration (the continuation used to fail after 1.6 s), naming both forces."""
+    p = load_params(overrides=LOW_MARGIN)
+    with pytest.raises(TrimError) as err:
+        find_equilibrium(p, 0.0, length=400.0)
+    msg = str(err.value)
+    assert "still air" in msg and "net lift (72.5 N)" in msg and "paid out (93.2 N)" in msg
+    assert find_equilibrium(p, 0.0, length=300.0).summary["winch_tension_N"] == pytest.approx(
+        p.derived.net_lift - p.derived.mass_per_length * 300.0 * p.environment.g, rel=1e-9)
+
+
 def test_low_margin_failure_names_the_margin():
     """Where the trim cannot be reached (here: an unreachable tolerance), the error gives the
     net lift, the tether's weight, the margin between them and the wind speed, and fails fast

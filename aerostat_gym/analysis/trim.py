@@ -267,11 +267,11 @@ def _paid_out_weight(params: Params, length: float | None) -> float:
 
 def _continue_in_tether_weight(params: Params, wind_speed: float, max_step: float, tol: float,
                                length: float | None,
-                               cause: TrimError) -> tuple[np.ndarray, float, int]:
+                               cause: TrimError | None) -> tuple[np.ndarray, float, int]:
     """Trim at ``wind_speed`` with a lighter tether (weighing LIFT_MARGIN_SHARE of the net lift,
     whose trim is well conditioned), then continue the tether's density back to its own value
     at that wind speed, in adaptive steps. Raises TrimError naming the net-lift margin where
-    this fails too."""
+    this fails too (after ``cause``, the continuation in wind's failure, where there was one)."""
     d, rho = params.derived, params.tether.density
     weight = _paid_out_weight(params, length)
     f = LIFT_MARGIN_SHARE * d.net_lift / weight
@@ -291,7 +291,8 @@ def _continue_in_tether_weight(params: Params, wind_speed: float, max_step: floa
                    f"out ({weight:.1f} N) by {-margin:.1f} N, so only the wind's lift can hold "
                    "the tether off the ground")
         return TrimError(
-            f"{cause}; {why}; continuing from a lighter tether at U = {wind_speed:g} m/s "
+            f"{f'{cause}; ' if cause else ''}{why}; continuing from a lighter tether at "
+            f"U = {wind_speed:g} m/s "
             f"{where}. A lighter aerostat (aerostat.mass), a larger one (aerostat.volume) or a "
             "shorter or lighter tether (length, tether.length, tether.density, tether.diameter) "
             "widens the margin")
@@ -332,7 +333,9 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
     TrimError if Newton fails to reach ``tol`` even with continuation steps of 1/64 of
     ``max_step`` (and, without a guess and where the tether weighs more than
     LIFT_MARGIN_SHARE of the net lift, also by continuation from a lighter tether at the
-    target wind speed; the message then gives the net-lift margin), or if the solution has a
+    target wind speed; the message then gives the net-lift margin; where the tether paid out
+    weighs at least the net lift, that continuation is the only path, and in still air there
+    is no equilibrium at all), or if the solution has a
     slack tether, the aerostat on or below the ground or tether below the ground (where the
     lift cannot carry the tether paid out: :func:`_check_flying`).
     """
@@ -342,22 +345,41 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
                          f"model's incompressible aerodynamics end near Mach 0.3), got "
                          f"{wind_speed!r}")
     model = Model(params, 0.0)
-    if guess is None:
-        x, u0 = zero_wind_state(params, length), 0.0
+    weight = _paid_out_weight(params, length)
+    if guess is None and weight >= params.derived.net_lift:
+        # No still-air equilibrium to continue from: the vertical line would leave the winch in
+        # compression (net lift - weight <= 0). Only the wind's lift can carry it.
+        _check_wind_can_lift(params, wind_speed, weight)
+        x, rel, its = _continue_in_tether_weight(params, wind_speed, max_step, tol, length, None)
     else:
-        x, u0 = guess.x.copy(), guess.wind_speed
-    try:
-        x, rel, its = _continue_in_wind(model, x, u0, wind_speed, max_step, tol)
-    except TrimError as exc:
-        if guess is not None or (_paid_out_weight(params, length)
-                                 <= LIFT_MARGIN_SHARE * params.derived.net_lift):
-            raise
-        x, rel, its = _continue_in_tether_weight(params, wind_speed, max_step, tol, length, exc)
+        if guess is None:
+            x, u0 = zero_wind_state(params, length), 0.0
+        else:
+            x, u0 = guess.x.copy(), guess.wind_speed
+        try:
+            x, rel, its = _continue_in_wind(model, x, u0, wind_speed, max_step, tol)
+        except TrimError as exc:
+            if guess is not None or weight <= LIFT_MARGIN_SHARE * params.derived.net_lift:
+                raise
+            x, rel, its = _continue_in_tether_weight(params, wind_speed, max_step, tol, length,
+                                                     exc)
     model.set_wind(wind_speed)
     summary = trim_summary(model, x, wind_speed)
     _check_flying(model, x, summary, wind_speed)
     return Equilibrium(x=x, wind_speed=float(wind_speed), params=params, residual=float(rel),
                        iterations=its, summary=summary)
+
+
+def _check_wind_can_lift(params: Params, wind_speed: float, weight: float) -> None:
+    """TrimError at once in still air where the tether paid out weighs at least the net lift:
+    the vertical line's tension at the winch, net lift - weight, would not be positive."""
+    if wind_speed == 0.0:
+        raise TrimError(
+            f"no equilibrium in still air: the net lift ({params.derived.net_lift:.1f} N) does "
+            f"not exceed the weight of the tether paid out ({weight:.1f} N), so only the wind's "
+            "lift could hold the tether off the ground. Less tether (length), a lighter one "
+            "(tether.density, tether.diameter) or a lighter or larger aerostat (aerostat.mass, "
+            "aerostat.volume) can")
 
 
 def _check_flying(model: Model, x: np.ndarray, summary: dict, wind_speed: float) -> None:
