@@ -24,8 +24,11 @@ from aerostat_gym.analysis.figures import (
 from aerostat_gym.analysis.linear import ACTUATORS, decouple, linearize
 from aerostat_gym.analysis.modes import (
     FIGURE9_MODES,
+    NEUTRAL_RATE,
     SETS,
+    Mode,
     count_modes,
+    damp_quantities,
     energy_vector,
     mac,
     mode_context,
@@ -41,7 +44,7 @@ from aerostat_gym.analysis.reference import (
 from aerostat_gym.analysis.sensitivity import default_knobs, solve_for_period, stability_figures
 from aerostat_gym.analysis.trim import TrimLimitError, find_equilibrium
 from aerostat_gym.bench.linear import bench_sweep
-from aerostat_gym.cli.stability import add_stability_parsers, parse_speeds
+from aerostat_gym.cli.stability import _fmt, add_stability_parsers, parse_speeds
 from aerostat_gym.params import load_params
 
 control = pytest.importorskip("control")
@@ -501,3 +504,21 @@ def test_sensitivity_names_an_end_without_trim_instead_of_calling_it_unstable(ba
     line = [s for s in format_sensitivity(tab).splitlines() if s.startswith(row["label"])][0]
     assert line.endswith("NO TRIM (high)") and "UNSTABLE" not in line
     assert "nan" not in line and line.count("n/a") == 5
+
+
+def _mode(lam: complex):
+    wn, zeta, period = damp_quantities(lam)
+    return Mode(lam, np.zeros(1), wn, zeta, period, lam.imag > 0, lam.real < 0 or wn < NEUTRAL_RATE,
+                wn < NEUTRAL_RATE)
+
+
+def test_stability_table_cells():
+    """A cell is period (damping ratio) by the closed form of lambda = -0.1 + 1j: omega_n =
+    sqrt(1.01), zeta = 0.1 / omega_n = 0.0995, period 2 pi / omega_n = 6.25 s; a real root
+    reads 'real (1.000)'; a neutral root (|lambda| below NEUTRAL_RATE) reads 'neutral' whatever
+    the sign of its rounding, where its ratio would read +-1."""
+    assert _fmt(_mode(complex(-0.1, 1.0))) == "   6.25 (0.100)"
+    assert _fmt(_mode(complex(-0.5, 0.0))) == "   real (1.000)"
+    for tiny in (0.1 * NEUTRAL_RATE, -0.1 * NEUTRAL_RATE):
+        assert _fmt(_mode(complex(tiny, 0.0))) == "        neutral"
+    assert _fmt(None) == "              -"

@@ -72,8 +72,12 @@ def stability_params(args):
 
 
 def _fmt(m) -> str:
+    """A table cell: period (damping ratio); a neutral root's ratio (+-1 by the sign of its
+    rounding) says nothing, so it reads "neutral"."""
     if m is None:
         return f"{'-':>15s}"
+    if m.neutral:
+        return f"{'neutral':>15s}"
     per = f"{m.period:7.2f}" if m.oscillatory else "   real"
     return f"{per} ({m.zeta:5.3f})"
 
