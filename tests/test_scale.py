@@ -271,7 +271,9 @@ def test_montecarlo_command_writes_its_outputs(tmp_path, capsys):
                              np.array([1.0, 2.0]))
     assert float(rows[0]["long_pendulum_s"]) == pytest.approx(direct.periods[0], rel=1e-12)
     assert (out / "montecarlo.png").stat().st_size > 10_000
-    assert "stable at every wind speed" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "Monte Carlo on baseline: 3 parameter sets" in text
+    assert "stable at every wind speed" in text
 
 
 # --- missing extra ---------------------------------------------------------------------------------------
@@ -314,9 +316,10 @@ def test_unreachable_cluster_is_one_line_exit_2(monkeypatch, capsys):
 def test_serial_path_runs_without_ray(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "ray", None)
     assert main(["montecarlo", "--samples", "1", "--serial", "--wind", "10", "--no-plot",
-                 "--out", str(tmp_path / "mc")]) == 0
+                 "--set", "tether.length=150", "--out", str(tmp_path / "mc")]) == 0
     summary = json.loads((tmp_path / "mc" / "summary.json").read_text())
     assert summary["samples"] == 1 and summary["correlations"] == []  # one set: nothing to correlate
+    assert summary["meta"]["configuration"] == "baseline --set tether.length=150"
     with pytest.raises(MissingExtraError, match="'ray' extra"):
         require("ray", "x")
 

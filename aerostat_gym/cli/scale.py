@@ -24,7 +24,7 @@ from ..scale.mc_report import summarize, write_outputs
 from ..scale.montecarlo import PERIOD_KEYS, SWEEP_SPEEDS, evaluate_sample, run_ray, run_serial
 from ..scale.ranges import RANGE_SOURCES, estimated_ranges
 from ..scale.tune import SCHEDULERS, SEARCHERS, SearchOptions, TrialSetup, load_space, run_search
-from .common import positive_float, positive_int, seed_int
+from .common import config_label, positive_float, positive_int, seed_int
 
 # the stability commands' parsing of --wind, --config and --set, shared rather than copied
 from .stability import parse_speeds
@@ -103,6 +103,7 @@ def montecarlo_command(args: argparse.Namespace) -> int:
         study = run_ray(base, ranges, args.samples, args.seed, speeds, args.address,
                         args.workers, args.batch_size, _progress)
     study.meta["ranges"] = args.ranges
+    study.meta["configuration"] = config_label(args)
     nominal = evaluate_sample(base, ranges, np.array([r.nominal for r in ranges]), study.speeds)
     summary = summarize(study, nominal)
     out = Path(args.out or f"runs/montecarlo/seed{args.seed}_n{args.samples}")
@@ -124,7 +125,8 @@ def format_summary(s: dict) -> str:
     ev = s["stable_everywhere"]
     lo, hi = ev["ci95"]
     lines = [
-        f"Monte Carlo: {s['samples']} parameter sets ({s['meta'].get('ranges', 'documented')} "
+        f"Monte Carlo on {s['meta'].get('configuration', 'baseline')}: {s['samples']} parameter "
+        f"sets ({s['meta'].get('ranges', 'documented')} "
         f"ranges, seed {s['seed']}), {s['backend']}: {s['seconds']:.1f} s, "
         f"{s['sets_per_s']:.2f} sets/s",
         f"stable at every wind speed: {ev['count']}/{s['samples']} = {100 * ev['fraction']:.1f} %"

@@ -228,7 +228,8 @@ def plot_study(study: Study, summary: dict, path: Path) -> Path:
     _plot_min_zeta(ax[1, 0], min_zeta(study))
     _plot_correlations(ax[1, 1], summary)
     frac = summary["stable_everywhere"]
-    fig.suptitle(f"Monte Carlo, {summary['samples']} parameter sets (seed {summary['seed']}): "
+    fig.suptitle(f"Monte Carlo on {summary['meta'].get('configuration', 'baseline')}, "
+                 f"{summary['samples']} parameter sets (seed {summary['seed']}): "
                  f"{100 * frac['fraction']:.1f} % stable at every wind speed")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
