@@ -528,12 +528,13 @@ class ImplausibleParameterError(ParameterError):
 
 
 #: Largest number of fin panels: the compiled core packs the panels into a fixed-size block
-#: (aerostat_gym.physics.packing.MAX_FINS, which must equal this; tests check it). params sits
-#: below the physics layer, so the constant is mirrored here rather than imported.
+#: (aerostat_gym.physics.packing.MAX_FINS is this constant; params sits below the physics
+#: layer, so the core imports it from here).
 MAX_FIN_PANELS = 6
-#: [m/s] the fastest mean wind the model is defined for (aerostat_gym.physics.wind.MAX_WIND_SPEED,
-#: which must equal this; tests check it): the aerodynamics are incompressible, valid below
-#: Mach 0.3, about 100 m/s at sea level. README "Guarantees": a faster mean wind is refused.
+#: [m/s] the fastest mean wind the model is defined for (every door checks this one): the
+#: aerodynamics are incompressible (one air density everywhere), valid below Mach 0.3, about
+#: 100 m/s at sea level. Tethered aerostats are flown far below it (the baseline's tether breaks at trim near
+#: 60 m/s). README "Guarantees": a faster mean wind is refused.
 MAX_WIND_SPEED = 100.0
 #: simulation.rk4_safety above this is past the measured stability edge of the RK4 step
 #: (aerostat_gym.physics.integrators.rk4_step: runs at 1.02 times the bound 2 sqrt(2) / omega_max

@@ -69,18 +69,26 @@ def _ancestors(name: str) -> set[str]:
     return {".".join(parts[:k]) for k in range(1, len(parts))}
 
 
-def _imports(module: str) -> tuple[set[str], list[str]]:
-    """(module-level internal imports, descriptions of imports inside functions)."""
-    tree = ast.parse(MODULES[module].read_text())
+def _imports(module: str, source: str | None = None) -> tuple[set[str], list[str]]:
+    """(internal imports run at import time, descriptions of imports inside functions). Import
+    time covers every statement outside a function: the module body and anything nested in a
+    ``try``, an ``if`` or a class body, not only the top-level statements."""
+    tree = ast.parse(MODULES[module].read_text() if source is None else source)
     top, nested = set(), []
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
-            for inner in ast.walk(node):
-                if isinstance(inner, (ast.Import, ast.ImportFrom)) and _resolve(module, inner):
-                    nested.append(f"{module}:{inner.lineno} in {node.name}()")
-    for node in tree.body:
-        if isinstance(node, (ast.Import, ast.ImportFrom)):
-            top.update(_resolve(module, node))
+
+    def visit(node, function: str | None) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
+                visit(child, function or getattr(child, "name", "lambda"))
+            elif isinstance(child, (ast.Import, ast.ImportFrom)):
+                if function is None:
+                    top.update(_resolve(module, child))
+                elif _resolve(module, child):
+                    nested.append(f"{module}:{child.lineno} in {function}()")
+            else:
+                visit(child, function)
+
+    visit(tree, None)
     # a module's own parent packages are initialised before it: not a dependency edge
     return top - _ancestors(module) - {module}, nested
 
@@ -128,6 +136,19 @@ def test_the_walker_sees_the_package():
     assert len(MODULES) > 50
     assert "aerostat_gym.physics.core" in GRAPH["aerostat_gym.physics.integrators"]
     assert "aerostat_gym.sim" in GRAPH["aerostat_gym.analysis.trim"]  # from ..sim import Model
+
+
+def test_the_walker_sees_imports_nested_at_import_time():
+    """An import in a try, an if or a class body runs at import time and is an edge; one in a
+    function or a lambda's default is not (a check of the check)."""
+    source = ("try:\n    from ..envs import env\nexcept ImportError:\n    pass\n"
+              "if True:\n    from ..agents import lqr\n"
+              "class C:\n    from ..sim import model\n"
+              "def f():\n    from ..cli import main\n")
+    top, nested = _imports("aerostat_gym.physics.outputs", source)
+    assert top == {"aerostat_gym.envs", "aerostat_gym.envs.env", "aerostat_gym.agents",
+                   "aerostat_gym.agents.lqr", "aerostat_gym.sim", "aerostat_gym.sim.model"}
+    assert nested == ["aerostat_gym.physics.outputs:10 in f()"]
 
 
 def test_no_import_cycle():

@@ -19,8 +19,7 @@ from aerostat_gym.checks import is_finite_number, is_number, is_whole
 from aerostat_gym.envs.config import TaskConfig, TaskError
 from aerostat_gym.envs.env import TetheredAerostatEnv
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
-from aerostat_gym.params import ParameterError, apply_overrides, load_params
-from aerostat_gym.physics.wind import MAX_WIND_SPEED
+from aerostat_gym.params import MAX_WIND_SPEED, ParameterError, apply_overrides, load_params
 from aerostat_gym.resources import SHIPPED_POLICY, shipped_path
 
 

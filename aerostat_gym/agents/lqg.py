@@ -47,7 +47,7 @@ import scipy.linalg as sla
 
 from ..analysis.linear import state_steps
 from ..analysis.trim import find_equilibrium
-from ..envs.spaces import CHANNELS, N_OBS, as_batch, check_obs_noise
+from ..envs.spaces import CHANNELS, N_OBS, OBS_INDEX, OBS_WIND_X, as_batch, check_obs_noise
 from ..params import Params
 from ..physics.state import StateLayout
 from ..sim import Model
@@ -63,13 +63,13 @@ from .modal import design_modal
 from .state_check import check_state_passed
 
 #: Standard observation channels the filter uses (name -> index), all longitudinal.
-MEASURED = {"dx": 0, "dz": 2, "vx": 3, "vz": 5, "dpitch": 7, "q": 10, "dtension": 13,
-            "dlength": 14, "reel_speed": 15}
+MEASURED = {name: OBS_INDEX[name] for name in ("dx", "dz", "vx", "vz", "dpitch", "q",
+                                               "dtension", "dlength", "reel_speed")}
 #: The features :meth:`LQGPolicy.estimate_features` gives: each measured channel as the
 #: filter's estimate reconstructs it, then the set-point just sent.
 ESTIMATE_FEATURES = tuple(f"{name}_estimate" for name in MEASURED) + ("base_command",)
 #: Channel of the measured along-wind air velocity (the wind-speed estimate for the schedule).
-WIND_CHANNEL = 16
+WIND_CHANNEL = OBS_WIND_X
 #: Time constant of the wind-speed estimate [s].
 WIND_TIME_CONSTANT = 20.0
 #: State feedbacks the filter's estimate can drive (``gains``).

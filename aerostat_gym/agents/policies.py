@@ -34,8 +34,7 @@ import numpy as np
 from ..analysis.reference import reference_periods
 from ..envs.config import TaskError, check_control_step, check_range
 from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION, as_batch, check_obs_noise
-from ..params import Params, as_params
-from ..physics.wind import MAX_WIND_SPEED
+from ..params import MAX_WIND_SPEED, Params, as_params
 from ..resources import SHIPPED_POLICY, shipped_path
 from .lqg import LQGPolicy, LQGSchedule
 from .lqr import LQRPolicy, LQRSchedule, schedule_speeds

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .authority import target_verdict
+from .authority import GUST_SCENARIOS, target_verdict
 from .protocol import aggregate, cell_values, paired_interval, paired_verdict
 
 #: The baselines the targets name; each must be in the validation results.
@@ -49,7 +49,6 @@ GUST_TARGETS = (
     ("peak tension not above passive", "peak_tension_N", "not_worse", "passive", None),
     ("terminations <= passive", "terminated", "no_more", "passive", None),
 )
-GUST_SCENARIOS = ("gusty_light", "gusty")
 
 
 def _met(kind: str, metric: str, mine: np.ndarray, ref: np.ndarray, factor) -> bool:

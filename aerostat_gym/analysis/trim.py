@@ -30,9 +30,8 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from ..checks import is_finite_number
-from ..params import Params, load_params
+from ..params import MAX_WIND_SPEED, Params, load_params
 from ..physics.core import rotation_matrix
-from ..physics.wind import MAX_WIND_SPEED
 from ..sim import Model
 
 REL_TOL = 1e-9

@@ -34,7 +34,7 @@ from ..analysis.sensitivity import (
     sensitivity_table,
 )
 from ..analysis.trim import TrimLimitError, find_equilibrium, limit_warnings
-from ..physics.wind import MAX_WIND_SPEED
+from ..params import MAX_WIND_SPEED
 from .common import add_config, output_dir, params_from_args, positive_float, positive_int, warn
 
 #: the most wind speeds one sweep takes: 0.05 m/s steps over the model's whole 0-100 m/s

@@ -15,7 +15,8 @@ import time
 import numpy as np
 
 from ..agents.intensity import air_inertia_force
-from ..physics.wind import MAX_WIND_SPEED, PROFILES, W_FIELD_DT, W_TAYLOR_U
+from ..params import MAX_WIND_SPEED
+from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
 from ..wind.field import build_wind, field_heights, field_times, mean_vector
 from ..wind.presets import INTENSITY_MODELS, METHODS, PRESETS
 from ..wind.sizing import FROM_CONFIG, sized_turbulence

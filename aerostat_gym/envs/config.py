@@ -14,6 +14,7 @@ import numpy as np
 
 from ..checks import is_finite_number, is_number, is_whole
 from ..params import (
+    MAX_WIND_SPEED,
     SECTIONS,
     InertiaError,
     ParameterError,
@@ -25,7 +26,6 @@ from ..params import (
     parameter_key,
     params_to_dict,
 )
-from ..physics.wind import MAX_WIND_SPEED
 from ..sim import INTEGRATORS
 from ..wind.presets import INTENSITY_CLASSES
 from ..wind.sizing import sized_turbulence

@@ -12,9 +12,7 @@ from ..sim.events import FAILURES, FIELD_END, OUTCOMES, RUNNING
 from . import reward
 from .batch import EnvBatch
 from .config import TaskConfig
-from .render import Frame, Renderer
-
-RENDER_MODES = ["human", "rgb_array"]
+from .render import RENDER_MODES, Frame, Renderer
 
 
 def frame(s: dict):
@@ -288,7 +286,7 @@ class TetheredAerostatEnv(gym.Env):
       the weights; an off-grid reset speed's trim is remembered by the environment.
     """
 
-    metadata = {"render_modes": RENDER_MODES, "render_fps": 5}
+    metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}
     #: an episode runs and the env is open, so step() may go on: set by reset() and
     #: set_state(), cleared by close() (a class default: also for instances made before it)
     _ready = False

@@ -12,9 +12,8 @@ import math
 
 import numpy as np
 
+from ..params import MAX_FIN_PANELS as MAX_FINS
 from ..params import Params
-
-MAX_FINS = 6
 
 # --- packed parameter vector ----------------------------------------------------------------------
 _FIELDS = [

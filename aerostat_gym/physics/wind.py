@@ -75,10 +75,6 @@ W_SIZE = 32
 
 PROFILES = {"uniform": 0, "power": 1, "log": 2}
 MIN_ADVECTION_SPEED = 1.0  # floor of U_a [m/s]: Taylor's hypothesis fails in calm air anyway
-#: [m/s] the fastest mean wind the model is defined for: its aerodynamics are incompressible
-#: (one air density everywhere), which holds below Mach 0.3, about 100 m/s at sea level. Tethered
-#: aerostats are flown far below it (the baseline's tether breaks at trim near 60 m/s).
-MAX_WIND_SPEED = 100.0
 
 
 def pack_wind(profile: str = "uniform", speed: float = 0.0, direction_deg: float = 0.0,
