@@ -12,7 +12,7 @@ from aerostat_gym.analysis.energy import mechanical_energy
 from aerostat_gym.analysis.signals import zero_crossing_period
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.params import ParameterError, load_params
-from aerostat_gym.sim import Model, SimulationError, simulate
+from aerostat_gym.sim import Model, SimulationError, events, simulate
 
 AERO_OFF = {"hull.CD0": 0.0, "hull.Cdc": 0.0, "hull.eta_k": 0.0, "fins.CL_alpha": 0.0,
             "fins.CD0": 0.0, "tether.Cd_normal": 0.0, "tether.damping_ratio": 0.0,
@@ -231,7 +231,11 @@ def test_tether_break_is_reported(base, trim0):
     weak = base.replace(**{"tether.strength": 3000.0, "winch.safe_working_load": 1000.0})
     tr = simulate(weak, trim0.x, 5.0, wind=15.0)
     assert tr.status == "break"
-    assert tr.events[-1]["event"] == "break" and "exceeded" in tr.events[-1]["message"]
+    end = tr.events[-1]
+    assert end["event"] == "break" and "exceeded" in end["message"]
+    assert end["threshold"] == 3000.0 and 3000.0 < end["value"] < 3100.0  # 3049 N
+    # the gust loads the line within half a second (re-run at finer steps, the break stands)
+    assert end["time"] == pytest.approx(0.5) == tr.time[-1]
 
 
 def test_fully_slack_tether_is_reported(base, trim0):
@@ -250,13 +254,36 @@ def test_fully_slack_tether_is_reported(base, trim0):
     assert tr.winch_tension[-1] > 0.5 * trim0.summary["winch_tension_N"]
 
 
-def test_nonfinite_state_is_reported_not_raised(base, trim0):
-    """A non-finite state mid-run (forced by an absurd time step) ends the run with status
-    'nonfinite' and keeps only finite samples."""
+def test_numerical_failure_is_reported_not_raised(base, trim0):
+    """RK4 at 0.05 s, 90 times its stability step, blows up within the second output
+    interval: a numerical failure, 'diverged' (a state past the physical bounds of
+    sim.events, as an environment would end the episode), reported with the interval's end
+    time; the run keeps only the good samples."""
     strong = base.replace(**{"tether.strength": 1e300})  # so 'break' cannot fire first
     tr = simulate(strong, trim0.x, 2.0, wind=10.0, integrator="rk4", dt=0.05)
-    assert tr.status == "nonfinite"
-    assert np.all(np.isfinite(tr.states))
+    assert tr.status == "diverged"
+    assert tr.events[-1]["event"] == "diverged" and "numerical failure" in tr.events[-1]["message"]
+    assert tr.events[-1]["time"] == pytest.approx(tr.time[-1] + 0.1)
+    assert np.all(np.isfinite(tr.states)) and tr.time[-1] < 1.0
+
+
+def test_a_ground_strike_ends_a_run(base, trim0, monkeypatch):
+    """A CM below the ground-strike height ends the run as it ends an episode: status
+    'ground_strike' at the first interval (the trim's CM is at 312.3 m, the strike height
+    raised here above it), the last sample kept, the height in the message."""
+    monkeypatch.setattr(events, "ground_height", lambda params: 400.0)
+    tr = simulate(base, trim0.x, 2.0, wind=0.0)
+    assert tr.status == "ground_strike" and tr.time[-1] == pytest.approx(0.1)
+    assert tr.events[-1]["event"] == "ground_strike"
+    assert "came down to 312.3" in tr.events[-1]["message"] and "(400 m)" in tr.events[-1]["message"]
+
+
+def test_a_start_outside_the_winch_limits_is_refused(base):
+    """Leaving the winch's length limits ends a run, so x0 must start inside them."""
+    x = find_equilibrium(base, 0.0, length=100.0).x
+    with pytest.raises(SimulationError, match=r"tether length 100 m is outside the winch's "
+                       r"limits \[150, 400\] m"):
+        simulate(base, x, 1.0, wind=0.0)
 
 
 def test_trim_failure_is_an_error():

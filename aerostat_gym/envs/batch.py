@@ -21,7 +21,7 @@ from ..physics.packing import P_SIZE
 from ..physics.state import StateLayout, work_size
 from ..physics.wind import W_SIZE, mean_wind, set_advection
 from ..sim import Model
-from ..sim.events import RUNNING
+from ..sim.events import RUNNING, ground_height
 from . import kernel as K
 from . import reward, spaces
 from .config import TaskConfig, TaskError
@@ -194,7 +194,7 @@ class EnvBatch:
         sim = params.simulation
         cfg[:K.C_DT] = scheme(t.integrator, sim.rk4_safety, sim.semi_implicit_dt)
         cfg[K.C_DT] = t.control_step
-        cfg[K.C_GROUND] = params.aerostat.diameter
+        cfg[K.C_GROUND] = ground_height(params)
         cfg[K.C_BRAKE_SPEED] = w.brake_speed
         cfg[K.C_HOLD_SPEED] = w.brake_hold_speed
         cfg[K.C_BRAKE_DWELL] = w.brake_dwell

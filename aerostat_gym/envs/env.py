@@ -128,7 +128,7 @@ class TetheredAerostatEnv(gym.Env):
     :func:`aerostat_gym.sim.events.diverged`; the observation is that of the last good state;
     no exception). A break, strike or limit is re-run with finer integration steps before it
     ends the episode: one they do not reproduce goes on from their state
-    (:func:`aerostat_gym.envs.kernel._resolve`). ``info["termination"]`` names the reason.
+    (:func:`aerostat_gym.sim.resolve.resolve`). ``info["termination"]`` names the reason.
     Truncated by the time limit set at
     registration (600 steps = 120 s at the default 0.2 s control step) or passed to
     ``gym.make(..., max_episode_steps=N)``: the turbulence fields are periodic and read modulo

@@ -6,8 +6,9 @@ The single environment and the vector environment call the same per-environment 
 environments), so environment i of a batch reproduces a single environment bit for bit. The
 integration is the simulator's own interval advance
 (:func:`aerostat_gym.physics.integrators.advance_interval`) and the episode-end check the
-simulator's (:func:`aerostat_gym.sim.events.step_outcome`): nothing here is a second copy of
-the simulator.
+simulator's (:func:`aerostat_gym.sim.events.step_outcome`, a terminating step decided by
+:func:`aerostat_gym.sim.resolve.resolve`, as :func:`aerostat_gym.sim.simulate` decides it):
+nothing here is a second copy of the simulator.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from ..physics.integrators import (
     advance_interval,
 )
 from ..physics.outputs import winch_tension
-from ..physics.packing import P_NEL, P_STRENGTH, P_W_VMAX
+from ..physics.packing import P_NEL, P_W_VMAX
 from ..physics.state import (
     S_LENGTH,
     S_P,
@@ -44,6 +45,7 @@ from ..physics.state import (
 )
 from ..physics.wind import W_UREF, air_velocity
 from ..sim import events as E
+from ..sim.resolve import resolve
 from ..sim.winch import brake_rule, brake_wanted
 from . import reward as R
 from . import spaces as S
@@ -175,8 +177,9 @@ def _step_one(x, x_prev, t, a, a_prev, braked, quiet, p, wp, wf, w, cfg, x_trim,
         return _failed(E.NONFINITE_OUTPUT, x, x_prev, t, p, wp, wf, w, cfg, x_trim, T_trim,
                        scale, lo, hi, obs, terms), brake, quiet, 0.0
     code = E.step_outcome(x, t1, p, stats[0], cfg[C_GROUND], cfg[C_HORIZON])
-    if code == E.TETHER_BREAK or code == E.GROUND_STRIKE or code == E.LENGTH_LIMIT:
-        code = _resolve(code, x, x_prev, t, u, p, wp, wf, w, cfg, stats)
+    if E.terminating(code):
+        code = resolve(code, x, x_prev, t, cfg[C_DT], u, p, wp, wf, w, cfg, stats,
+                       cfg[C_GROUND], cfg[C_HORIZON])
         # refill w, and observe the refined state when the step was re-integrated
         if not math.isfinite(observe(x, t1, p, wp, wf, w, cfg, x_trim, T_trim, scale, lo, hi,
                                      obs)):
@@ -187,153 +190,6 @@ def _step_one(x, x_prev, t, a, a_prev, braked, quiet, p, wp, wf, w, cfg, x_trim,
     R.reward_terms(obs, a, a_prev, stats[0], code, cfg[C_WEIGHTS:], cfg[C_SWL],
                    cfg[C_LENGTH_BAND], terms)
     return code, brake, quiet, stats[0]
-
-
-#: [-] a terminating step is physical when half the integration step reproduces its end state
-#: to this fraction of the state's largest entry (integration error is far smaller; an
-#: integrator past its stability step misses by orders of magnitude)
-REPRODUCE_TOL = 1e-3
-#: Finest re-run of a terminating step that half the step does not reproduce: the integration
-#: step over 2**MAX_REFINE (3 ms for the semi-implicit 50 ms)
-MAX_REFINE = 4
-
-
-@njit(**_JIT)
-def _rerun(level, x_out, x_prev, t, u, p, wp, wf, w, cfg, stats):
-    """The control step from x_prev again, at the integration step over 2**level, into x_out
-    and stats; returns its outcome code (NONFINITE when the integration fails)."""
-    fine = cfg.copy()
-    shrink = 0.5 ** level
-    fine[C_RK4_SAFETY] *= shrink
-    fine[C_SI_DT] *= shrink
-    fine[C_STEP] *= shrink
-    x_out[:] = x_prev
-    stats[0] = 0.0
-    stats[1] = np.inf
-    if advance_interval(x_out, t, cfg[C_DT], u, p, wp, wf, w, fine, stats) == NONFINITE:
-        return E.NONFINITE
-    return E.step_outcome(x_out, t + cfg[C_DT], p, stats[0], cfg[C_GROUND], cfg[C_HORIZON])
-
-
-@njit(**_JIT)
-def _same_end(a, b):
-    """End states within REPRODUCE_TOL of the larger state's largest entry (at least 1)."""
-    big = 1.0
-    for i in range(a.size):
-        big = max(big, abs(a[i]), abs(b[i]))
-    for i in range(a.size):
-        if not abs(a[i] - b[i]) <= REPRODUCE_TOL * big:
-            return False
-    return True
-
-
-@njit(**_JIT)
-def _gap(a, b):
-    """Largest entry of |a - b|."""
-    g = 0.0
-    for i in range(a.size):
-        g = max(g, abs(a[i] - b[i]))
-    return g
-
-
-#: Largest ratio |x(h) - x(h/2)| / |x(h/2) - x(h/4)| of a step that is merely inaccurate at h:
-#: a converging first-order step halves its error with the step (ratio 2; the semi-implicit
-#: scheme, and RK4 too once slack elements or the brake make the response non-smooth), here
-#: with a margin of 2. A step past its stability bound, or one from a state an unstable step
-#: has already corrupted, misses by more (RK4 at 1.4 times its bound: 5.5-6.5).
-ERROR_RATIO_LIMIT = 4.0
-
-
-#: [-] a break whose peak tension half the step misses by more than this factor is an unstable
-#: step (RK4 past its bound): DIVERGED
-BREAK_PEAK_RATIO = 2.0
-#: [-] the semi-implicit step's tether-break peaks count as settled when two successive step
-#: sizes give them within this ratio (a physical break: 36.2 and 36.3 kN at 50 and 25 ms)
-SNAP_PEAK_RATIO = 1.1
-
-
-@njit(**_JIT)
-def _within(a, b, ratio):
-    """a and b within a factor ``ratio`` of each other."""
-    return b / ratio <= a <= b * ratio
-
-
-@njit(**_JIT)
-def _resolve(code, x, x_prev, t, u, p, wp, wf, w, cfg, stats):
-    """Decide a terminating control step (tether break, ground strike, length limit) by
-    re-running it from x_prev with finer integration steps. Returns the outcome code; x and
-    stats hold the state and tension statistics the episode goes on from. Runs only on a
-    terminating step.
-
-    - A semi-implicit break whose peak tension half the step does not reproduce within
-      SNAP_PEAK_RATIO is decided by :func:`_settle_snap`.
-    - Half the step reproduces the event (the same event, for a break with a peak tension
-      within BREAK_PEAK_RATIO, or an end state within REPRODUCE_TOL): the event is physical and
-      the step stands.
-    - Half the step fails, or (for a break) its peak tension differs by more than
-      BREAK_PEAK_RATIO: the integrator was past its stability step (it is stable at half the
-      step, or blows up differently): DIVERGED.
-    - The coarse step's difference from half the step is more than ERROR_RATIO_LIMIT times
-      half the step's difference from a quarter: not an inaccurate step but an unstable one
-      (or one from a state an unstable step has corrupted): DIVERGED.
-    - Otherwise the coarse step misjudged the response (typically a tension peak near the
-      strength overshot by a few per cent in a violent excursion): the step is halved again
-      until two successive halvings agree on the outcome, and the finer of the two stands,
-      event or not (no event: the episode goes on from the refined state). No agreement by
-      MAX_REFINE halvings: DIVERGED.
-    """
-    peak, least = stats[0], stats[1]
-    coarse = np.empty(x.size)
-    fine = np.empty(x.size)
-    got = _rerun(1, coarse, x_prev, t, u, p, wp, wf, w, cfg, stats)
-    if got == E.NONFINITE or got == E.DIVERGED:
-        return E.DIVERGED
-    if code == E.TETHER_BREAK and cfg[C_SEMI_IMPLICIT] != 0.0 \
-            and not _within(stats[0], peak, SNAP_PEAK_RATIO):
-        return _settle_snap(got, x, x_prev, t, u, p, wp, wf, w, cfg, stats, fine)
-    if code == E.TETHER_BREAK and not _within(stats[0], peak, BREAK_PEAK_RATIO):
-        return E.DIVERGED
-    if got == code or _same_end(coarse, x):
-        stats[0], stats[1] = peak, least  # the original step stands (x untouched)
-        return code
-    coarse_error = _gap(x, coarse)
-    for level in range(2, MAX_REFINE + 1):
-        finer = _rerun(level, fine, x_prev, t, u, p, wp, wf, w, cfg, stats)
-        if finer == E.NONFINITE or finer == E.DIVERGED:
-            return E.DIVERGED
-        if level == 2 and not coarse_error <= ERROR_RATIO_LIMIT * _gap(coarse, fine):
-            return E.DIVERGED
-        if finer == got:
-            x[:] = fine
-            return finer
-        got = finer
-    return E.DIVERGED
-
-
-@njit(**_JIT)
-def _settle_snap(got, x, x_prev, t, u, p, wp, wf, w, cfg, stats, fine):
-    """A semi-implicit tether break that half the step (outcome ``got``, peak in stats[0])
-    does not reproduce. The scheme keeps the tether's stiffness implicit, so this is not an
-    instability but the snap of a slack element that goes taut within one step: it is
-    stretched by its closing speed times the step, on short stiff elements a spike far above
-    the physical snap load (measured, 55 m on 24 elements at 20 m/s in severe turbulence: 750,
-    262, 55 and 33.2 kN at 50, 25, 12.5 and 6.25 ms, 33.2 kN below at 3.1 ms; the strength is
-    35.6 kN). The step is halved until two successive halvings agree on the outcome and on the
-    peak tension, within SNAP_PEAK_RATIO or both that far below the strength (a slack,
-    snapping tether's small peaks do not converge in ratio: 0.2, 0.3, 0.4 kN); the finer
-    stands, break or not. No agreement by MAX_REFINE halvings, or a failed re-run: DIVERGED."""
-    last_peak = stats[0]
-    for level in range(2, MAX_REFINE + 1):
-        finer = _rerun(level, fine, x_prev, t, u, p, wp, wf, w, cfg, stats)
-        if finer == E.NONFINITE or finer == E.DIVERGED:
-            return E.DIVERGED
-        settled = _within(stats[0], last_peak, SNAP_PEAK_RATIO) \
-            or max(stats[0], last_peak) < p[P_STRENGTH] / SNAP_PEAK_RATIO
-        if finer == got and settled:
-            x[:] = fine
-            return finer
-        got, last_peak = finer, stats[0]
-    return E.DIVERGED
 
 
 @njit(**_JIT)

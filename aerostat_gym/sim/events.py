@@ -1,8 +1,9 @@
 """Episode outcomes of a control step, decided in one compiled place.
 
-The environment's compiled step (:mod:`aerostat_gym.envs.kernel`) and the simulator's winch
-events (:class:`aerostat_gym.sim.winch.WinchController`) both call these functions, so a tether
-break, a ground strike or a length-limit excursion means the same thing in every front end.
+The environments' compiled step (:mod:`aerostat_gym.envs.kernel`) and the simulator's
+:func:`aerostat_gym.sim.simulate` both call :func:`step_outcome`, and both decide a terminating
+step with :func:`aerostat_gym.sim.resolve.resolve`, so a tether break, a ground strike or a
+length-limit excursion means the same thing in every front end.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from ..physics.state import S_LENGTH, S_P, S_REEL, S_VX, S_X, S_Z, aerostat_offs
 #: beyond every physical bound (:func:`diverged`) or, in the environments, a terminating event
 #: (break, ground strike, length limit) that finer integration steps show to come from an
 #: integrator past its stability step, or that they cannot settle
-#: (:func:`aerostat_gym.envs.kernel._resolve`). An event that only the coarse step sees (a
+#: (:func:`aerostat_gym.sim.resolve.resolve`). An event that only the coarse step sees (a
 #: tension peak near the strength overshot) is not an outcome: the step is re-integrated.
 (RUNNING, NONFINITE, TETHER_BREAK, GROUND_STRIKE, LENGTH_LIMIT, FIELD_END, DIVERGED,
  NONFINITE_OUTPUT) = range(8)
@@ -73,6 +74,19 @@ def diverged(x, p, peak_tension):
         if not abs(x[o + S_P + k]) <= RATE_DIVERGED:
             return True
     return not abs(x[o + S_REEL]) <= REEL_DIVERGED * p[P_W_VMAX]
+
+
+def ground_height(params) -> float:
+    """CM height [m] below which the aerostat has struck the ground: one hull diameter (the
+    model has no ground contact, so a run ends there)."""
+    return float(params.aerostat.diameter)
+
+
+@njit(**_JIT)
+def terminating(code):
+    """A physical event that ends a run (break, ground strike, length limit): re-run with finer
+    steps before it stands (:func:`aerostat_gym.sim.resolve.resolve`)."""
+    return code == TETHER_BREAK or code == GROUND_STRIKE or code == LENGTH_LIMIT
 
 
 @njit(**_JIT)

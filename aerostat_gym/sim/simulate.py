@@ -1,6 +1,8 @@
 """Trajectories: :func:`simulate` integrates the model and returns the time histories with
-named fields, reporting tether break, full slackness and numerical failure as events rather
-than raising.
+named fields, reporting tether break, ground strike, full slackness and numerical failure as
+events rather than raising. Each output interval ends as an environment's control step does
+(:func:`aerostat_gym.sim.events.step_outcome`, a terminating one decided by
+:func:`aerostat_gym.sim.resolve.resolve`).
 """
 
 from __future__ import annotations
@@ -11,11 +13,20 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..params import Params
-from ..physics.integrators import NONFINITE
+from ..physics.integrators import NONFINITE, advance_interval
 from ..physics.state import N_INPUTS
 from ..wind.field import check_covers
+from . import events as E
 from .model import BRAKED, Model, SimulationError, check_finite, check_integrator
+from .resolve import resolve
 from .winch import WinchController
+
+#: Trajectory.status of a run that an outcome ended (RUNNING: it ran to the end, "ok").
+STATUS = {E.RUNNING: "ok", E.NONFINITE: "nonfinite", E.TETHER_BREAK: "break",
+          E.GROUND_STRIKE: "ground_strike", E.LENGTH_LIMIT: "length_limit",
+          E.DIVERGED: "diverged"}
+#: Numerical failures: the run stops at the last good sample, the failed interval dropped.
+_FAILED = (E.NONFINITE, E.DIVERGED)
 
 
 @dataclass
@@ -81,11 +92,17 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
 
     Returns
     -------
-    Trajectory. ``status`` is "ok", "break" (an element exceeded the tether strength; the run
-    stops there), or "nonfinite" (numerical failure; the run stops at the last finite sample).
-    A fully slack tether is recorded in ``events`` ("slack") and the run continues, as are the
-    onsets of the winch events "winch_slack" (load cell below winch.slack_tension) and
-    "over_tension" (an element above winch.safe_working_load).
+    Trajectory. ``status`` is "ok", or what ended the run early, as it ends an environment's
+    episode: "break" (an element exceeded the tether strength), "ground_strike" (the CM below
+    one hull diameter), "length_limit" (the tether length outside the winch's limits), with
+    the run kept up to and including that sample; or a numerical failure, "nonfinite" (the
+    state became non-finite) or "diverged" (a finite state beyond every physical bound, or an
+    event that finer integration steps show to be the integrator's), with the run stopped at
+    the last good sample. A terminating interval is re-run with finer steps first, and a
+    tension peak that only the coarse step saw ends nothing. Each ending is also the last
+    entry of ``events``. A fully slack tether is recorded in ``events`` ("slack") and the run
+    continues, as are the onsets of the winch events "winch_slack" (load cell below
+    winch.slack_tension) and "over_tension" (an element above winch.safe_working_load).
 
     Notes
     -----
@@ -99,6 +116,7 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
     x = check_finite("x0", np.array(x0, dtype=float))
     if x.shape != (lay.size,):
         raise SimulationError(f"x0 must have shape ({lay.size},) for n = {model.n}, got {x.shape}")
+    _check_length(model, x)
     if not (math.isfinite(duration) and duration > 0):
         raise SimulationError(f"duration must be finite and > 0, got {duration!r}")
     if not (math.isfinite(output_dt) and output_dt > 0):
@@ -110,15 +128,15 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
         check_covers(model.wp, model.wf, n_out * output_dt)
     winch = WinchController(model.params, output_dt)  # the stand-still clock ticks per interval
     times, states, tens, ends = [0.0], [x.copy()], [model.tensions(x)], [model.end_tensions(x)]
+    scheme, ground = model.scheme(integrator, dt), E.ground_height(model.params)
     status, events, cmds = "ok", [], []
     for k in range(n_out):
         t = k * output_dt
         cmd = winch.command(_input(u, t, x), x, winch.load_cell(ends[-1][1]))
-        st, stats = model.advance(x, t, output_dt, cmd.as_input(), integrator, dt)
-        if st == NONFINITE:
-            status = "nonfinite"
-            events.append({"time": t + output_dt, "event": "nonfinite",
-                           "message": "state became non-finite (numerical failure)"})
+        code, stats = _interval(model, x, t, output_dt, cmd.as_input(), scheme, ground)
+        if code in _FAILED:
+            status = STATUS[code]
+            events.append(_failure_event(code, t + output_dt))
             break
         cmds.append(cmd)
         times.append(t + output_dt)
@@ -128,26 +146,74 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
         if stats[1] <= 0.0:
             events.append({"time": t + output_dt, "event": "slack",
                            "message": "every tether element was slack during this interval"})
-        new = winch.detect_events(t + output_dt, winch.load_cell(ends[-1][1]), stats[0])
-        events.extend(new)
-        if any(e["event"] == "break" for e in new):
-            status = "break"
+        events.extend(winch.detect_events(t + output_dt, winch.load_cell(ends[-1][1]), stats[0]))
+        if code != E.RUNNING:
+            status = STATUS[code]
+            if code != E.TETHER_BREAK:  # the winch's events already end with the break
+                events.append(_ending_event(code, t + output_dt, x, model))
             break
     S = np.array(states)
     nodes = np.array([model.node_positions(s) for s in S])
-    E = np.array(ends)
+    end_T = np.array(ends)
     L = S[:, lay.winch_length]
     return Trajectory(
         time=np.array(times), states=S, cm_pos=S[:, lay.cm_pos], cm_vel=S[:, lay.cm_vel],
         euler=S[:, lay.euler], rates=S[:, lay.rates], node_pos=nodes, tensions=np.array(tens),
-        top_tension=E[:, 0], winch_tension=E[:, 1], length=L,
+        top_tension=end_T[:, 0], winch_tension=end_T[:, 1], length=L,
         reel_speed=S[:, lay.winch_speed], status=status, events=events,
-        load_cell=np.array([winch.load_cell(b) for b in E[:, 1]]),
+        load_cell=np.array([winch.load_cell(b) for b in end_T[:, 1]]),
         mass_aloft=winch.mass_aloft(L), mass_on_drum=winch.mass_on_drum(L),
         v_set_requested=np.array([c.requested for c in cmds]),
         v_set=np.array([c.v_set for c in cmds]), brake=np.array([c.brake for c in cmds], dtype=bool),
         clipped_count=sum(c.clipped for c in cmds), thresholds=winch.thresholds.as_dict(),
     )
+
+
+def _check_length(model: Model, x: np.ndarray) -> None:
+    """x0's tether length within the winch's limits (leaving them ends a run, as it ends an
+    episode, so a start outside them would end the run at once)."""
+    w, L = model.params.winch, float(x[model.layout.winch_length])
+    if not w.min_length - E.LENGTH_TOL <= L <= w.max_length + E.LENGTH_TOL:
+        raise SimulationError(
+            f"x0's tether length {L:g} m is outside the winch's limits [{w.min_length:g}, "
+            f"{w.max_length:g}] m (winch.min_length, winch.max_length): trim at a length "
+            "within them, or widen them")
+
+
+def _interval(model: Model, x: np.ndarray, t: float, interval: float, u: np.ndarray,
+              scheme: np.ndarray, ground: float) -> tuple[int, np.ndarray]:
+    """Advance x over one output interval and decide its outcome as an environment's control
+    step does: (outcome code of :mod:`aerostat_gym.sim.events`, tension stats). x holds the
+    state the run goes on from (re-integrated where a terminating step was re-run)."""
+    x_prev = x.copy()
+    stats = np.array([0.0, np.inf])
+    if advance_interval(x, t, interval, u, model.p, model.wp, model.wf, model.work, scheme,
+                        stats) == NONFINITE:
+        return E.NONFINITE, stats
+    code = E.step_outcome(x, t + interval, model.p, stats[0], ground, math.inf)
+    if E.terminating(code):
+        code = resolve(code, x, x_prev, t, interval, u, model.p, model.wp, model.wf,
+                       model.work, scheme, stats, ground, math.inf)
+    return code, stats
+
+
+def _failure_event(code: int, t: float) -> dict:
+    text = ("state became non-finite" if code == E.NONFINITE else
+            "the integration diverged (a state beyond every physical bound, or an event that "
+            "finer integration steps do not reproduce)")
+    return {"time": t, "event": STATUS[code], "message": f"{text} (numerical failure)"}
+
+
+def _ending_event(code: int, t: float, x: np.ndarray, model: Model) -> dict:
+    lay = model.layout
+    if code == E.GROUND_STRIKE:
+        text = (f"the aerostat's CM came down to {x[lay.cm_pos][2]:.2f} m, below one hull "
+                f"diameter ({E.ground_height(model.params):g} m)")
+    else:
+        w = model.params.winch
+        text = (f"the tether length {x[lay.winch_length]:.3f} m left the winch's limits "
+                f"[{w.min_length:g}, {w.max_length:g}] m")
+    return {"time": t, "event": STATUS[code], "message": text}
 
 
 def _input(u, t: float, x: np.ndarray) -> np.ndarray:
