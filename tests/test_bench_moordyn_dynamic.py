@@ -200,9 +200,6 @@ def test_smoke_agreement(quick_cli):
     assert r["top_harmonic"] == 2  # across the wind the tension swings at twice the drive
     assert abs(r["top_lag_deg"]) < 5.0  # measured ~1 deg of the 0.84 s harmonic
     assert si["top_rms_pct"] < 1.0 and si["pos_max_pct"] < 0.5, si
-    for code in ("rk4", "semi-implicit"):
-        assert row[code]["speed_ratio"] > 0 and row[code]["wall_s"] > 0
-    assert quick_cli["moordyn_step_call_overhead"]["per_step_s"] > 0
 
 
 def test_same_equations_agree_to_time_discretization():

@@ -24,6 +24,7 @@ from aerostat_gym.envs import (
     TetheredAerostatEnv,
     observation_table,
     sb3_vec_env,
+    spaces,
 )
 from aerostat_gym.envs.spaces import N_OBS
 from aerostat_gym.physics.state import StateLayout
@@ -94,13 +95,31 @@ def test_pickle_and_deepcopy_continue_identically():
 
 
 def test_reward_is_sum_of_named_terms():
+    """The reward is the sum of the info terms, and each term is its formula (reward.REWARD_DOC,
+    default weights on the 300 m baseline, band 15 m = 1.5 scaled) applied to the observation,
+    the action and the peak tension the step returned (float32 observation: rel 1e-5)."""
     env = gym.make(ENV_ID)
     env.reset(seed=3)
+    swl, prev = env.unwrapped.task.params_resolved.winch.safe_working_load, 0.0
+    ch = {name: spaces.OBS_INDEX[name] for name in spaces.OBS_INDEX}
     for k in range(20):
-        _, r, _, _, info = env.step(np.array([math.sin(k / 3.0)], np.float32))
+        a = math.sin(k / 3.0)
+        o, r, _, _, info = env.step(np.array([a], np.float32))
+        a = float(np.float32(a))
         terms = [info["reward_" + t] for t in REWARD_TERMS]
         assert all(t <= 0.0 for t in terms)
         assert abs(r - sum(terms)) <= 1e-12 * max(1.0, abs(r))  # float precision
+        o = o.astype(float)
+        expect = {"displacement": -(o[ch["dx"]] ** 2 + o[ch["dy"]] ** 2),
+                  "velocity": -(o[ch["vx"]] ** 2 + o[ch["vy"]] ** 2),
+                  "pitch": -0.1 * o[ch["dpitch"]] ** 2, "pitch_rate": -0.1 * o[ch["q"]] ** 2,
+                  "effort": -0.01 * a * a, "effort_rate": -0.1 * (a - prev) ** 2,
+                  "over_tension": -10.0 * max(0.0, info["peak_tension"] / swl - 1.0),
+                  "termination": 0.0,
+                  "length": -max(0.0, abs(o[ch["dlength"]]) - 1.5) ** 2}
+        for name, value in expect.items():
+            assert info["reward_" + name] == pytest.approx(value, rel=1e-5, abs=1e-9), name
+        prev = a
 
 
 def test_nan_action_is_a_clear_error_and_out_of_range_is_clipped():

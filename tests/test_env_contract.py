@@ -18,14 +18,17 @@ from aerostat_gym.sim.winch import WinchController
 
 CALM = {"turbulence": "none", "perturbation": "none"}
 
-#: (state offset in the aerostat block, displacement in SI units, observation channel)
+#: (state offset in the aerostat block, displacement in SI units, observation channel, the
+#: channel's documented scale on the 300 m baseline: README's observation table, 10 m, 2 m/s,
+#: 0.05 rad, 0.02 rad/s, 10 m of length, 1 m/s of reel speed)
 DISPLACEMENTS = [
-    (st.S_X, 1.0, spaces.OBS_DX), (st.S_Y, -2.0, spaces.OBS_DY), (st.S_Z, 0.5, spaces.OBS_DZ),
-    (st.S_VX, 0.3, spaces.OBS_VX), (st.S_VY, -0.2, spaces.OBS_VY), (st.S_VZ, 0.1, spaces.OBS_VZ),
-    (st.S_PHI, 0.02, spaces.OBS_DROLL), (st.S_THETA, -0.01, spaces.OBS_DPITCH),
-    (st.S_PSI, 0.03, spaces.OBS_DYAW), (st.S_P, 0.004, spaces.OBS_P), (st.S_Q, -0.006, spaces.OBS_Q),
-    (st.S_R, 0.008, spaces.OBS_R), (st.S_LENGTH, 2.0, spaces.OBS_DLENGTH),
-    (st.S_REEL, 0.4, spaces.OBS_REEL_SPEED),
+    (st.S_X, 1.0, spaces.OBS_DX, 10.0), (st.S_Y, -2.0, spaces.OBS_DY, 10.0),
+    (st.S_Z, 0.5, spaces.OBS_DZ, 10.0), (st.S_VX, 0.3, spaces.OBS_VX, 2.0),
+    (st.S_VY, -0.2, spaces.OBS_VY, 2.0), (st.S_VZ, 0.1, spaces.OBS_VZ, 2.0),
+    (st.S_PHI, 0.02, spaces.OBS_DROLL, 0.05), (st.S_THETA, -0.01, spaces.OBS_DPITCH, 0.05),
+    (st.S_PSI, 0.03, spaces.OBS_DYAW, 0.05), (st.S_P, 0.004, spaces.OBS_P, 0.02),
+    (st.S_Q, -0.006, spaces.OBS_Q, 0.02), (st.S_R, 0.008, spaces.OBS_R, 0.02),
+    (st.S_LENGTH, 2.0, spaces.OBS_DLENGTH, 10.0), (st.S_REEL, 0.4, spaces.OBS_REEL_SPEED, 1.0),
 ]
 
 
@@ -47,19 +50,18 @@ def calm_env():
     return env.unwrapped
 
 
-@pytest.mark.parametrize("offset, delta, channel", DISPLACEMENTS)
-def test_channel_sign_against_a_known_displacement(calm_env, offset, delta, channel):
-    """Displacing one state entry from the trim moves its channel by delta / scale, exactly in
-    sign and to float32 precision (1e-6 relative), and leaves the other kinematic channels at
-    zero (the trim)."""
+@pytest.mark.parametrize("offset, delta, channel, scale", DISPLACEMENTS)
+def test_channel_sign_against_a_known_displacement(calm_env, offset, delta, channel, scale):
+    """Displacing one state entry from the trim moves its channel by delta / the documented
+    scale, exactly in sign and to float32 precision (1e-6 relative), and leaves the other
+    kinematic channels at zero (the trim)."""
     b = calm_env._batch
     b.state[0] = b.trim_state[0]
     b.state[0, b.layout.aerostat + offset] += delta
     b.observe(0)
     obs = b.obs[0]
-    expect = delta / spaces.CHANNELS[channel].scale
-    assert obs[channel] == pytest.approx(expect, rel=1e-6)
-    kinematic = [c for _, _, c in DISPLACEMENTS if c != channel]
+    assert obs[channel] == pytest.approx(delta / scale, rel=1e-6)
+    kinematic = [row[2] for row in DISPLACEMENTS if row[2] != channel]
     np.testing.assert_array_equal(obs[kinematic], 0.0)
 
 

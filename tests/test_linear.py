@@ -426,7 +426,6 @@ def test_bench_sweep_reports():
     res = bench_sweep(repeats=1)
     assert res["n_speeds"] == 41 and res["all_stable"]
     assert res["per_speed_ms"] == pytest.approx(1e3 * res["linear_sweep_s"] / 41, rel=1e-12)
-    assert res["within_budget"] == (res["linear_sweep_s"] <= res["budget_s"])
 
 
 # --- full tables and scripts (about 7 s together) -----------------------------------------

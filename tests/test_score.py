@@ -18,13 +18,23 @@ from aerostat_gym.envs.reward import (
     R_DISPLACEMENT,
     R_LENGTH,
     R_VELOCITY,
+    REWARD_TERMS,
     reward_terms,
     weights_vector,
 )
-from aerostat_gym.envs.spaces import N_OBS, OBS_DLENGTH, OBS_DX, OBS_VX
+from aerostat_gym.envs.spaces import (
+    N_OBS,
+    OBS_DLENGTH,
+    OBS_DPITCH,
+    OBS_DX,
+    OBS_DY,
+    OBS_Q,
+    OBS_VX,
+    OBS_VY,
+)
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
 from aerostat_gym.params import load_params
-from aerostat_gym.sim.events import RUNNING
+from aerostat_gym.sim.events import DIVERGED, FIELD_END, RUNNING, TETHER_BREAK
 
 BAND = LENGTH_BAND_FRACTION * 300.0 / 10.0  # the baseline's 15 m, in the 10 m channel scale
 
@@ -35,6 +45,26 @@ def _terms(dlength=0.0, dx=0.0, vx=0.0):
     terms = np.zeros(len(DEFAULT_WEIGHTS))
     reward_terms(obs, 0.0, 0.0, 0.0, RUNNING, weights_vector(None), 1.0e4, BAND, terms)
     return terms
+
+
+def test_every_term_against_its_formula():
+    """Each default term on a known state, by hand: dx, dy = 0.3, -0.4 (0.25); vx, vy = 0.6,
+    0.8 (1.0); dpitch = 2 (4); q = -1 (1); a = 0.5 after -0.5; peak 1.5 x SWL; |dL| = 2.5
+    against the 1.5 band (1.0); a tether break. Weights 1, 1, 0.1, 0.1, 0.01, 0.1, 10, 100, 1."""
+    obs = np.zeros(N_OBS, np.float32)
+    obs[[OBS_DX, OBS_DY, OBS_VX, OBS_VY, OBS_DPITCH, OBS_Q, OBS_DLENGTH]] = (
+        0.3, -0.4, 0.6, 0.8, 2.0, -1.0, -2.5)
+    terms = np.zeros(len(DEFAULT_WEIGHTS))
+    reward_terms(obs, 0.5, -0.5, 1.5e4, TETHER_BREAK, weights_vector(None), 1.0e4, BAND, terms)
+    expect = {"displacement": -0.25, "velocity": -1.0, "pitch": -0.4, "pitch_rate": -0.1,
+              "effort": -0.0025, "effort_rate": -0.1, "over_tension": -5.0,
+              "termination": -100.0, "length": -1.0}
+    for name, value in expect.items():
+        assert terms[REWARD_TERMS.index(name)] == pytest.approx(value, rel=1e-6), name
+    for code, penalty in ((RUNNING, 0.0), (FIELD_END, 0.0), (DIVERGED, -100.0)):
+        reward_terms(obs, 0.5, -0.5, 0.5e4, code, weights_vector(None), 1.0e4, BAND, terms)
+        assert terms[REWARD_TERMS.index("termination")] == penalty
+        assert terms[REWARD_TERMS.index("over_tension")] == 0.0  # below the SWL
 
 
 def test_length_wander_is_free_inside_the_band():
