@@ -29,7 +29,6 @@ def main(argv=None) -> int:
     ap.add_argument("--model", default="mil", choices=[m for m in INTENSITY_MODELS if m != "fixed"])
     args = ap.parse_args(argv)
     p = load_params()
-    a = p.aerostat
     print(f"sigma_u / U(h) at the aerostat, realised (target), {args.episodes} episodes x 120 s, "
           f"intensity model {args.model}:")
     print("  class    " + "".join(f"{u:>18.0f} m/s" for u in SPEEDS))
@@ -47,8 +46,7 @@ def main(argv=None) -> int:
         for u in SPEEDS:
             wp, wf = build_wind({"speed": u}, {"preset": cls, "intensity_model": args.model},
                                 600.0, np.random.default_rng(0))
-            f = air_inertia_force(wp, wf, (0.0, 0.0, 300.0), p.environment.rho_air * a.volume,
-                                  a.k1, a.k3, a.length, 600.0, 0.05)
+            f = air_inertia_force(p, wp, wf, (0.0, 0.0, 300.0), 600.0, 0.05)
             cells.append(f"{f['rms_lateral_n']:6.0f} / {f['peak_n']:5.0f}")
         print(f"  {cls:9s}" + "".join(f"{c:>22s}" for c in cells))
     return 0

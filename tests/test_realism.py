@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from aerostat_gym.agents.intensity import realised_intensity
+from aerostat_gym.agents.intensity import air_inertia_force, realised_intensity
 from aerostat_gym.agents.sideslip import yaw_curve
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.params import load_params
@@ -237,6 +237,24 @@ def test_air_inertia_closed_form():
     inertia = prm.aerostat.inertia_tensor
     moment = inertia @ (out["on"][lay.rates] - out["off"][lay.rates])
     assert moment == pytest.approx(np.cross(prm.aerostat.cb_position, want), rel=1e-9, abs=1e-9)
+
+
+def test_air_inertia_report_on_a_hull_along_the_wind():
+    """The wind command's air-inertia report (the core's load on a hull held along the mean
+    wind, direction 30 deg) in uniformly accelerating air, a = (0.7, -0.4, 0.25) m/s^2 in
+    mean-wind axes: (1 + k1) rho V 0.7 along, (1 + k3) rho V 0.4 across, (1 + k3) rho V 0.25
+    normal to the wind, the peak their magnitude, the air acceleration |a| (rel 1e-9)."""
+    prm = load_params()
+    a = np.array([0.7, -0.4, 0.25])
+    wp, wf = _accelerating_air(a, direction_deg=30.0)
+    got = air_inertia_force(prm, wp, wf, (0.0, 0.0, 300.0), 10.0, 0.5)
+    rho_v, k1, k3 = (prm.environment.rho_air * prm.aerostat.volume, prm.aerostat.k1,
+                     prm.aerostat.k3)
+    want = rho_v * np.array([(1 + k1) * 0.7, (1 + k3) * 0.4, (1 + k3) * 0.25])
+    assert [got["rms_axial_n"], got["rms_lateral_n"], got["rms_vertical_n"]] == pytest.approx(
+        want, rel=1e-9)
+    assert got["peak_n"] == pytest.approx(np.linalg.norm(want), rel=1e-9)
+    assert got["rms_air_acceleration_m_s2"] == pytest.approx(np.linalg.norm(a), rel=1e-9)
 
 
 def test_air_inertia_vanishes_in_steady_wind():

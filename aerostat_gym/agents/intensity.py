@@ -4,9 +4,14 @@ force the turbulence puts on the hull."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..envs.vector import TetheredAerostatVectorEnv
+from ..params import Params
+from ..physics.core import air_inertia_load, rotation_matrix
+from ..physics.packing import pack_params
 from ..physics.wind import W_DIRC, W_DIRS, air_acceleration, air_velocity, mean_speed
 from ..wind.presets import resolve_turbulence
 
@@ -60,33 +65,20 @@ def realised_intensity(turbulence, wind_speed: float, episodes: int = 20,
             "speed_at_height": uh, "samples": int(u.size)}
 
 
-def air_inertia_force(wp: np.ndarray, wf: np.ndarray, point, rho_volume: float,
-                      k_axial: float, k_lateral: float, length: float, duration: float,
+def air_inertia_force(params: Params, wp: np.ndarray, wf: np.ndarray, point, duration: float,
                       dt: float = SAMPLE_DT) -> dict:
-    """RMS and peak air-inertia force [N] on a hull held at ``point`` with its axis along the
-    mean wind: (1 + k1) rho V a_u along the axis, (1 + k3) rho V a_v, a_w across it, with
-    a the air acceleration averaged over the hull length.
+    """RMS and peak air-inertia force [N] on the configured hull held at ``point`` with its
+    axis along the mean wind: the compiled core's load
+    (:func:`aerostat_gym.physics.core.air_inertia_load`, (1 + k_i) rho V a_i along body axis i,
+    a the air acceleration averaged over the hull length), sampled every ``dt`` over
+    ``duration`` seconds.
 
     Parameters
     ----------
-    wp : ndarray
-        Wind-parameter vector (:func:`aerostat_gym.wind.build_wind`).
-    wf : ndarray
-        Turbulence field of that wind.
-    point : (float, float, float)
-        Inertial position of the hull's centre of buoyancy [m].
-    rho_volume : float
-        Displaced air mass rho V [kg].
-    k_axial : float
-        Axial added-mass coefficient k1 [-].
-    k_lateral : float
-        Lateral added-mass coefficient k3 [-].
-    length : float
-        Hull length [m]: the air acceleration is averaged over it along the wind.
-    duration : float
-        Record length [s].
-    dt : float
-        Sampling step [s].
+    params : the aerostat (volume, added-mass coefficients, hull length).
+    wp, wf : wind-parameter vector and turbulence field (:func:`aerostat_gym.wind.build_wind`).
+    point : (x, y, z) inertial position of the hull's centre of buoyancy [m].
+    duration, dt : record length and sampling step [s].
 
     Returns
     -------
@@ -95,13 +87,11 @@ def air_inertia_force(wp: np.ndarray, wf: np.ndarray, point, rho_volume: float,
         RMS air acceleration [m/s^2].
     """
     x, y, z = point
+    p = pack_params(params)
+    R = rotation_matrix(0.0, 0.0, math.atan2(wp[W_DIRS], wp[W_DIRC])).reshape(-1)
     times = np.arange(0.0, duration, dt)
-    a = np.array([air_acceleration(x, y, z, t, wp, wf, length) for t in times])
-    c, s = wp[W_DIRC], wp[W_DIRS]
-    au = a[:, 0] * c + a[:, 1] * s  # along the mean wind: the hull axis
-    av = -a[:, 0] * s + a[:, 1] * c
-    f = rho_volume * np.stack([(1.0 + k_axial) * au, (1.0 + k_lateral) * av,
-                               (1.0 + k_lateral) * a[:, 2]], axis=1)
+    a = np.array([air_acceleration(x, y, z, t, wp, wf, params.aerostat.length) for t in times])
+    f = np.array([air_inertia_load(t, x, y, z, p, R, wp, wf) for t in times]).reshape(-1, 3)
     mag = np.linalg.norm(f, axis=1)
     return {"rms_axial_n": float(np.sqrt(np.mean(f[:, 0] ** 2))),
             "rms_lateral_n": float(np.sqrt(np.mean(f[:, 1] ** 2))),

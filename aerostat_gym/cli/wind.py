@@ -163,10 +163,7 @@ def wind_command(args) -> int:
 
 def _air_inertia(params, cfg, wp, wf, duration: float) -> dict:
     """Air-inertia force on the configured hull held at the field's reference height."""
-    a = params.aerostat
-    return air_inertia_force(wp, wf, (0.0, 0.0, cfg.reference_height),
-                             params.environment.rho_air * a.volume, a.k1, a.k3, a.length,
-                             duration)
+    return air_inertia_force(params, wp, wf, (0.0, 0.0, cfg.reference_height), duration)
 
 
 def _table(out: dict) -> str:

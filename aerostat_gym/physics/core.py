@@ -28,7 +28,7 @@ Model ([LN02]; equations reconstructed in docs/parameters.md section 4)
   post-stall lift is the option ``fins.post_stall = 'flat'``).
 - Air inertia: in accelerating air (turbulence, gusts) the hull feels the Froude-Krylov force
   rho V dW/dt plus the added-mass force k_i rho V dW_i/dt per body axis, applied at the
-  centre of buoyancy (:func:`_air_inertia`); dW/dt is the local time derivative at the hull
+  centre of buoyancy (:func:`air_inertia_load`); dW/dt is the local time derivative at the hull
   point averaged over the hull length along the wind
   (:func:`aerostat_gym.physics.wind.air_acceleration`). Zero in steady wind.
 - Inertia: translational added mass m_e = m + k rho V per body axis. The inertial terms use
@@ -589,13 +589,13 @@ def _aero_loads(t, x, p, wp, wf, w, R, o):
         Fx, Fy, Fz, Mx, My, Mz = _add_load(Fx, Fy, Fz, Mx, My, Mz, cx, cy, cz, ffx, ffy, ffz)
     if p[P_AIRINERTIA] != 0.0 and (wp[W_GUST_ON] != 0.0 or (wp[W_TURB_ON] != 0.0 and wf.shape[1] > 1)):
         hp = points_offset(n) + 3 * n  # the hull point (centre of buoyancy), inertial
-        aix, aiy, aiz = _air_inertia(t, w[hp], w[hp + 1], w[hp + 2], p, R, wp, wf)
+        aix, aiy, aiz = air_inertia_load(t, w[hp], w[hp + 1], w[hp + 2], p, R, wp, wf)
         Fx, Fy, Fz, Mx, My, Mz = _add_load(Fx, Fy, Fz, Mx, My, Mz, xb, yb, zb, aix, aiy, aiz)
     return Fx, Fy, Fz, Mx, My, Mz
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def _air_inertia(t, px, py, pz, p, R, wp, wf):
+def air_inertia_load(t, px, py, pz, p, R, wp, wf):
     """Body-frame force of accelerating air on the hull at inertial point (px, py, pz).
 
     The pressure gradient that accelerates the air at a = dW/dt (averaged over the hull's
