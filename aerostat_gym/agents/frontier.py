@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.linear import propagate
 from ..envs.vector import TetheredAerostatVectorEnv
 from .metrics import fit_damped_sinusoid
 from .metrics_drift import fit_pendulum_with_drift
@@ -213,10 +214,7 @@ def initial_deviation(wind_speed: float, swing: float, params=None) -> np.ndarra
 def linear_response(Acl: np.ndarray, K: np.ndarray, dx0: np.ndarray, steps: int
                     ) -> tuple[np.ndarray, np.ndarray]:
     """(states, set-points) of the discrete closed loop x_{k+1} = Acl x_k, v_k = -K x_k."""
-    X = np.empty((steps + 1, dx0.size))
-    X[0] = dx0
-    for k in range(steps):
-        X[k + 1] = Acl @ X[k]
+    X = propagate(Acl, dx0, steps)
     return X, -(X[:-1] @ K)
 
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from ..analysis.linear import propagate
 from ..analysis.modes import analyse
 from ..analysis.trim import find_equilibrium
 from ..envs.config import DEFAULT_WIND_RANGE
@@ -37,7 +38,6 @@ from .evaluate import (
     tether_length_of,
 )
 from .fit_guides import FAST_MODE_FACTOR, fit_guides, is_baseline
-from .frontier import linear_response
 from .metrics import _failed, fit_damped_sinusoid, response_metrics
 from .metrics_modes import fit_modes, nearest_mode
 from .policies import PassivePolicy, load_policy
@@ -72,8 +72,7 @@ def linear_pitch_check(params, wind_speed: float, scenario: str = "recover",
     mech = lay.n_mechanical
     steps = int(round(SCENARIOS[scenario].duration / dt))
     Ad = sla.expm(lin.A * dt)  # braked: the paid-out length is fixed, no set-point
-    X, _ = linear_response(Ad, np.zeros(mech), scenario_start(params, wind_speed, scenario)[:mech],
-                           steps)
+    X = propagate(Ad, scenario_start(params, wind_speed, scenario)[:mech], steps)
     t = np.arange(steps + 1) * dt
     zero = np.zeros(steps + 1)
     fit = response_metrics(t, X[:, lay.cm_pos.start], X[:, lay.euler.start + 1], zero, zero)

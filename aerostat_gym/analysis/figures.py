@@ -17,7 +17,7 @@ from scipy.linalg import expm
 
 from ..params import Params, load_params
 from ..sim import Model, simulate
-from .linear import linearize
+from .linear import linearize, propagate
 from .modes import FIGURE9_MODES, SETS, Sweep, wind_sweep
 from .trim import find_equilibrium
 
@@ -88,15 +88,9 @@ def linear_response(A: np.ndarray, dx0: np.ndarray, times: np.ndarray) -> np.nda
 
     Notes
     -----
-    Exact for the LTI system: dx_{k+1} = Phi dx_k with Phi = expm(A dt).
+    Exact for the LTI system: dx_{k+1} = Phi dx_k with Phi = expm(A dt) (:func:`propagate`).
     """
-    dt = float(times[1] - times[0])
-    Phi = expm(A * dt)
-    out = np.empty((times.size, dx0.size))
-    out[0] = dx0
-    for k in range(1, times.size):
-        out[k] = Phi @ out[k - 1]
-    return out
+    return propagate(expm(A * float(times[1] - times[0])), dx0, times.size - 1)
 
 
 def nrms(linear: np.ndarray, nonlinear: np.ndarray) -> float:

@@ -280,3 +280,14 @@ def decouple(A: np.ndarray, layout: StateLayout) -> Decoupled:
     return Decoupled(A_long=A[np.ix_(li, li)], A_lat=A[np.ix_(ti, ti)], A_ul=ul, A_ll=ll,
                      long_idx=li, lat_idx=ti, long_names=[names[i] for i in li],
                      lat_names=[names[i] for i in ti], max_entry=amax, ratios=ratios)
+
+
+def propagate(Phi: np.ndarray, dx0: np.ndarray, steps: int) -> np.ndarray:
+    """States dx_0 ... dx_steps (rows) of the discrete linear map dx_{k+1} = Phi dx_k: a free
+    response with Phi = expm(A dt) (exact for the LTI system at the sampling instants), or a
+    sampled closed loop with Phi its closed-loop matrix."""
+    out = np.empty((steps + 1, dx0.size))
+    out[0] = dx0
+    for k in range(steps):
+        out[k + 1] = Phi @ out[k]
+    return out
