@@ -54,6 +54,7 @@ from ..envs.config import DEFAULT_WIND_RANGE, check_control_step
 from ..envs.spaces import REFERENCE_TETHER_LENGTH, displacement_scale
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import Params, as_params, dumps_toml
+from ..physics.state import S_Q, S_THETA, S_X, S_Y
 from .fit_guides import guide_kwargs, guides_for, screen_fits
 from .metrics import response_metrics
 from .policies import load_policy
@@ -312,8 +313,8 @@ def run_scenario(policy, scenario: str, speeds, seeds, control_step: float = 0.2
     obs, _ = env.reset(seed=[s for _, s in pairs],
                        options={"wind_speed": [u for u, _ in pairs]})
     b, lay = env.batch, env.batch.layout
-    ix, iy, ith = lay.cm_pos.start, lay.cm_pos.start + 1, lay.euler.start + 1
-    iq, iv, il = lay.rates.start + 1, lay.winch_speed, lay.winch_length
+    ix, iy, ith = lay.at(S_X), lay.at(S_Y), lay.at(S_THETA)
+    iq, iv, il = lay.at(S_Q), lay.winch_speed, lay.winch_length
     names = ("x", "y", "pitch", "q", "length", "tension", "reel")
     rec = {k: np.zeros((len(pairs), steps + 1)) for k in names}
 

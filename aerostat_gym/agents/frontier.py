@@ -30,6 +30,7 @@ import numpy as np
 
 from ..analysis.linear import propagate
 from ..envs.vector import TetheredAerostatVectorEnv
+from ..physics.state import S_X
 from .metrics import fit_damped_sinusoid
 from .metrics_drift import fit_pendulum_with_drift
 from .modal import design_modal
@@ -166,7 +167,7 @@ def swing_response(policy, wind_speed: float, swing: float, *, brake_speed: floa
     obs, _ = env.reset(seed=[seed], options={"wind_speed": [wind_speed]})
     b, lay = env.batch, env.batch.layout
     vmax = float(b.params.winch.max_speed)
-    ix, iL, iv = lay.cm_pos.start, lay.winch_length, lay.winch_speed
+    ix, iL, iv = lay.at(S_X), lay.winch_length, lay.winch_speed
     steps = env.max_episode_steps
     x, L, v, sp = (np.zeros(steps + 1) for _ in range(4))
     x[0], L[0], v[0] = _sample(b, ix, iL, iv)

@@ -49,7 +49,7 @@ from ..analysis.linear import state_steps
 from ..analysis.trim import find_equilibrium
 from ..envs.spaces import CHANNELS, N_OBS, OBS_INDEX, OBS_WIND_X, as_batch, check_obs_noise
 from ..params import Params
-from ..physics.state import StateLayout
+from ..physics.state import S_Q, S_THETA, S_VX, S_VZ, S_X, S_Z, StateLayout
 from ..sim import Model
 from .lqr import (
     DEFAULT_SPEEDS,
@@ -130,9 +130,9 @@ def measurement_matrix(params: Params, lqr: LQRDesign, idx: np.ndarray) -> np.nd
     """C (len(MEASURED), len(idx)): SI measurements as linear functions of the subset state."""
     lay = lqr.linear.layout
     pos = {j: k for k, j in enumerate(idx)}
-    direct = {"dx": lay.cm_pos.start, "dz": lay.cm_pos.start + 2, "vx": lay.cm_vel.start,
-              "vz": lay.cm_vel.start + 2, "dpitch": lay.euler.start + 1,
-              "q": lay.rates.start + 1, "dlength": lay.winch_length,
+    direct = {"dx": lay.at(S_X), "dz": lay.at(S_Z), "vx": lay.at(S_VX),
+              "vz": lay.at(S_VZ), "dpitch": lay.at(S_THETA),
+              "q": lay.at(S_Q), "dlength": lay.winch_length,
               "reel_speed": lay.winch_speed}
     C = np.zeros((len(MEASURED), idx.size))
     for r, name in enumerate(MEASURED):

@@ -60,7 +60,7 @@ from ..analysis.trim import Equilibrium, find_equilibrium
 from ..checks import is_finite_number
 from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND, as_batch
 from ..params import Params, dumps_toml
-from ..physics.state import StateLayout
+from ..physics.state import S_PSI, StateLayout
 from .state_check import check_state_passed
 from .swing_plane import in_swing_plane
 
@@ -613,7 +613,7 @@ def full_observation(x: np.ndarray, x_trim: np.ndarray, wind_speed: float,
     at ``OBS_FULL_WIND`` and x - x_trim with the yaw wrapped to [-pi, pi) from
     ``OBS_FULL_STATE``."""
     dx = x - x_trim
-    i_psi = layout.euler.start + 2
+    i_psi = layout.at(S_PSI)
     dx[i_psi] = (dx[i_psi] + np.pi) % (2.0 * np.pi) - np.pi
     obs = np.zeros(OBS_FULL_STATE + layout.size)
     obs[OBS_FULL_WIND], obs[OBS_FULL_STATE:] = wind_speed, dx
@@ -719,7 +719,7 @@ class LQRPolicy:
             z[np.asarray(episode_start, dtype=bool).reshape(-1)] = 0.0
         U = obs2[:, OBS_FULL_WIND]
         dx = obs2[:, OBS_FULL_STATE:OBS_FULL_STATE + self.layout.size].copy()
-        ipsi = self.layout.euler.start + 2
+        ipsi = self.layout.at(S_PSI)
         dx[:, ipsi] = (dx[:, ipsi] + np.pi) % (2.0 * np.pi) - np.pi
         if self.swing_plane:
             sch = self.schedule

@@ -27,6 +27,7 @@ from ..analysis.trim import find_equilibrium
 from ..envs.config import DEFAULT_WIND_RANGE
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import as_params
+from ..physics.state import S_THETA, S_X
 from .evaluate import (
     RECOVER_SCENARIOS,
     SCENARIOS,
@@ -75,7 +76,7 @@ def linear_pitch_check(params, wind_speed: float, scenario: str = "recover",
     X = propagate(Ad, scenario_start(params, wind_speed, scenario)[:mech], steps)
     t = np.arange(steps + 1) * dt
     zero = np.zeros(steps + 1)
-    fit = response_metrics(t, X[:, lay.cm_pos.start], X[:, lay.euler.start + 1], zero, zero)
+    fit = response_metrics(t, X[:, lay.at(S_X)], X[:, lay.at(S_THETA)], zero, zero)
     ep = run_scenario(PassivePolicy(), scenario, [wind_speed], [0], control_step=dt,
                       env_kwargs={"params": params})
     nonlinear = response_metrics(ep.time, ep.x[0], ep.pitch[0], ep.tension[0], ep.reel_speed[0])
@@ -88,7 +89,7 @@ def linear_pitch_check(params, wind_speed: float, scenario: str = "recover",
         key = label.replace(" ", "_")
         out[f"{key}_zeta"] = mode.zeta if mode else float("nan")
         out[f"{key}_period_s"] = mode.period if mode else float("nan")
-    pitching = _pitching_fit(t, X[:, lay.cm_pos.start], X[:, lay.euler.start + 1], modal,
+    pitching = _pitching_fit(t, X[:, lay.at(S_X)], X[:, lay.at(S_THETA)], modal,
                              away=True)
     out["linear_modes_fit_zeta"], out["linear_modes_fit_period_s"] = (pitching.zeta,
                                                                        pitching.period)

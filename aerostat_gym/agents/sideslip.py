@@ -11,6 +11,7 @@ from ..envs.spaces import CHANNELS, OBS_WIND_X, OBS_WIND_Y, OBS_WIND_Z
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import apply_overrides, load_params
 from ..physics.core import rotation_matrix
+from ..physics.state import S_PSI, S_R
 from ..sim import Model
 
 OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 75, 90)
@@ -39,8 +40,8 @@ def yaw_curve(wind_speed: float = 8.0, overrides: dict | None = None,
     out = []
     for deg in offsets:
         x = eq.x.copy()
-        x[lay.euler.start + 2] += np.radians(deg)
-        out.append(float(model.rhs(x)[lay.rates.start + 2]))
+        x[lay.at(S_PSI)] += np.radians(deg)
+        out.append(float(model.rhs(x)[lay.at(S_R)]))
     return out
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..physics.core import rotation_matrix
+from ..physics.state import S_Z
 from ..sim import Model
 
 
@@ -30,9 +31,9 @@ def mechanical_energy(model: Model, x: np.ndarray) -> float:
     kinetic = (0.5 * m_node * np.sum(x[lay.node_vel] ** 2)
                + 0.5 * vb @ (np.array(d.effective_mass) * vb) + 0.5 * om @ a.inertia_tensor @ om)
     nodes = model.node_positions(x)
-    z_cb = x[lay.cm_pos][2] + (R @ np.array(a.cb_position))[2]
+    z_cb = x[lay.at(S_Z)] + (R @ np.array(a.cb_position))[2]
     potential = (m_node * g * np.sum(nodes[1:-1, 2]) + 0.5 * m_node * g * nodes[0, 2]
-                 + a.mass * g * x[lay.cm_pos][2] - d.buoyancy * z_cb)
+                 + a.mass * g * x[lay.at(S_Z)] - d.buoyancy * z_cb)
     lengths = np.linalg.norm(np.diff(nodes, axis=0), axis=1)
     eps = np.maximum(lengths / l_u - 1.0, 0.0)
     elastic = 0.5 * d.EA * l_u * np.sum(eps**2)

@@ -32,6 +32,7 @@ import scipy.sparse.linalg
 from ..checks import is_finite_number
 from ..params import MAX_WIND_SPEED, Params, load_params
 from ..physics.core import rotation_matrix
+from ..physics.state import S_Z
 from ..sim import Model
 
 REL_TOL = 1e-9
@@ -388,7 +389,7 @@ def _check_flying(model: Model, x: np.ndarray, summary: dict, wind_speed: float)
     the lumped tether leaves the winch downwards and hangs in a sag below it, where a real one
     would lie on the ground (the baseline with aerostat.mass = 587.9 kg, 72.5 N of net lift,
     on 400 m of tether, 93.2 N, at 1 m/s: 72 m below)."""
-    height = x[model.layout.cm_pos][2]
+    height = x[model.layout.at(S_Z)]
     if summary["min_tension_N"] <= 0 or height <= 0:
         raise TrimError(f"the solution at U = {wind_speed} m/s is not a flying equilibrium "
                         f"(min tension {summary['min_tension_N']:.1f} N, height {height:.1f} m)")

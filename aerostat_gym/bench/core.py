@@ -16,6 +16,7 @@ from numba import njit
 from ..analysis.trim import find_equilibrium
 from ..params import Params, load_params
 from ..physics.core import rhs
+from ..physics.state import S_THETA, S_X
 from ..sim import BRAKED, Model, simulate
 from .env import bench_env
 from .linear import bench_sweep
@@ -71,8 +72,8 @@ def semi_implicit_accuracy(params: Params, wind_speed: float = 10.0, seconds: fl
     eq = find_equilibrium(params, wind_speed)
     lay = Model(params).layout
     x = eq.x.copy()
-    x[lay.cm_pos.start] += 1.0
-    x[lay.euler.start + 1] += 0.02
+    x[lay.at(S_X)] += 1.0
+    x[lay.at(S_THETA)] += 0.02
     a = simulate(params, x, seconds, wind=wind_speed, integrator="rk4", output_dt=0.1)
     b = simulate(params, x, seconds, wind=wind_speed, integrator="semi-implicit", output_dt=0.1)
     return {
@@ -96,7 +97,7 @@ def run_bench(quick: bool = False) -> dict:
     eq = find_equilibrium(params, wind)
     model = Model(params, wind)
     x = eq.x.copy()
-    x[model.layout.cm_pos.start] += 1.0
+    x[model.layout.at(S_X)] += 1.0
     out = {"machine": machine(), "case": f"baseline, n = {model.n}, U = {wind} m/s, single thread"}
     out["rhs_us"] = bench_rhs(model, x, n_calls=50_000 if quick else 200_000)
     out["rk4"] = bench_integrator(model, x, "rk4", seconds=20.0 if quick else 60.0)

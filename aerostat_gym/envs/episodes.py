@@ -18,7 +18,7 @@ from ..checks import is_number
 from ..params import InertiaError, ParameterError, Params, apply_overrides, dumps_toml
 from ..physics.core import euler_angles, rotation_matrix
 from ..physics.packing import pack_params
-from ..physics.state import StateLayout
+from ..physics.state import S_Z, StateLayout
 from ..physics.wind import (
     mean_wind,
     set_advection,
@@ -418,7 +418,7 @@ def _perturb(x_trim, params, pert, wp, ua, rng) -> tuple[np.ndarray, dict]:
     # the swing pivots on the winch, wherever the configuration puts it: positions are taken
     # relative to the anchor, rotated, and put back (exact for an anchor at the origin)
     anchor = np.array(params.tether.anchor_position, float)
-    height = x[lay.cm_pos][2] - anchor[2]
+    height = x[lay.at(S_Z)] - anchor[2]
     Rs = rotation_matrix(0.0, swing / height, 0.0) @ rotation_matrix(-lateral / height, 0.0, 0.0)
     nodes = x[lay.node_pos].reshape(-1, 3) - anchor
     x[lay.node_pos] = (nodes @ Rs.T + anchor).ravel()

@@ -120,7 +120,9 @@ class StateLayout:
     def n_mechanical(self) -> int:
         return 6 * self.n_elements + 6
 
-    def _a(self, k: int) -> int:
+    def at(self, k: int) -> int:
+        """Index of the aerostat-block entry ``k`` (an ``S_*`` offset), e.g. ``at(S_THETA)``,
+        the pitch angle."""
         return self.aerostat + k
 
     @property
@@ -133,27 +135,27 @@ class StateLayout:
 
     @property
     def cm_pos(self) -> slice:
-        return slice(self._a(S_X), self._a(S_VX))
+        return slice(self.at(S_X), self.at(S_VX))
 
     @property
     def cm_vel(self) -> slice:
-        return slice(self._a(S_VX), self._a(S_PHI))
+        return slice(self.at(S_VX), self.at(S_PHI))
 
     @property
     def euler(self) -> slice:
-        return slice(self._a(S_PHI), self._a(S_P))
+        return slice(self.at(S_PHI), self.at(S_P))
 
     @property
     def rates(self) -> slice:
-        return slice(self._a(S_P), self._a(S_LENGTH))
+        return slice(self.at(S_P), self.at(S_LENGTH))
 
     @property
     def winch_length(self) -> int:
-        return self._a(S_LENGTH)
+        return self.at(S_LENGTH)
 
     @property
     def winch_speed(self) -> int:
-        return self._a(S_REEL)
+        return self.at(S_REEL)
 
     @property
     def mechanical(self) -> slice:
@@ -175,13 +177,13 @@ class StateLayout:
         (4 n + 2 states).
         """
         n = self.n_nodes
-        pos = lambda c: [3 * k + c for k in range(n)] + [self._a(c)]  # noqa: E731
-        vel = lambda c: [3 * n + 3 * k + c for k in range(n)] + [self._a(S_VX + c)]  # noqa: E731
-        return np.array(pos(0) + vel(0) + pos(2) + vel(2) + [self._a(S_THETA), self._a(S_Q)])
+        pos = lambda c: [3 * k + c for k in range(n)] + [self.at(c)]  # noqa: E731
+        vel = lambda c: [3 * n + 3 * k + c for k in range(n)] + [self.at(S_VX + c)]  # noqa: E731
+        return np.array(pos(0) + vel(0) + pos(2) + vel(2) + [self.at(S_THETA), self.at(S_Q)])
 
     def lateral_indices(self) -> np.ndarray:
         """[LN02] lateral set: y and its rate for every node, phi, p, psi, r (2 n + 4 states)."""
         n = self.n_nodes
-        ys = [3 * k + 1 for k in range(n)] + [self._a(S_Y)]
-        vys = [3 * n + 3 * k + 1 for k in range(n)] + [self._a(S_VY)]
-        return np.array(ys + vys + [self._a(S_PHI), self._a(S_P), self._a(S_PSI), self._a(S_R)])
+        ys = [3 * k + 1 for k in range(n)] + [self.at(S_Y)]
+        vys = [3 * n + 3 * k + 1 for k in range(n)] + [self.at(S_VY)]
+        return np.array(ys + vys + [self.at(S_PHI), self.at(S_P), self.at(S_PSI), self.at(S_R)])

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..params import Params
 from ..physics.integrators import NONFINITE, advance_interval
-from ..physics.state import N_INPUTS
+from ..physics.state import N_INPUTS, S_Z
 from ..wind.field import check_covers
 from . import events as E
 from .model import BRAKED, Model, SimulationError, check_finite, check_integrator
@@ -207,7 +207,7 @@ def _failure_event(code: int, t: float) -> dict:
 def _ending_event(code: int, t: float, x: np.ndarray, model: Model) -> dict:
     lay = model.layout
     if code == E.GROUND_STRIKE:
-        text = (f"the aerostat's CM came down to {x[lay.cm_pos][2]:.2f} m, below one hull "
+        text = (f"the aerostat's CM came down to {x[lay.at(S_Z)]:.2f} m, below one hull "
                 f"diameter ({E.ground_height(model.params):g} m)")
     else:
         w = model.params.winch
