@@ -108,7 +108,7 @@ from ..analysis.reference import reference_periods
 from ..analysis.trim import find_equilibrium
 from ..params import Params, load_params
 from ..physics.core import rhs
-from ..physics.integrators import NONFINITE, OK, si_advance
+from ..physics.integrators import NONFINITE, OK, all_finite, si_advance
 from ..physics.packing import P_CDN, P_DASHPOT, P_DIAM, P_EA, P_G, P_MU, P_NEL, P_RHO
 from ..physics.state import (
     S_LENGTH,
@@ -328,14 +328,6 @@ def _place_top(x, o, path, t, h_secant):
 
 
 @njit(cache=True)
-def _all_finite(x):
-    for i in range(x.size):
-        if not math.isfinite(x[i]):
-            return False
-    return True
-
-
-@njit(cache=True)
 def moordyn_segment_tension(x, p, w, e):
     """Axial force of element e under MoorDyn's rule (``Line::getStateDeriv``): the elastic
     part EA (l - l_u) / l_u only when stretched, plus the dashpot BA ldot / l_u (BA = b = c* l_u)
@@ -489,7 +481,7 @@ def driven_rk4(x, t, h, nsteps, path, u, p, wp, wf, w, swap):
         for i in range(m):
             x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
     _place_top(x, o, path, t + nsteps * h, 0.0)
-    return OK if _all_finite(x) else NONFINITE
+    return OK if all_finite(x) else NONFINITE
 
 
 @njit(cache=True)

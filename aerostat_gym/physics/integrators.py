@@ -86,7 +86,8 @@ def _tension_stats(w, n, stats):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)
-def _finite(x):
+def all_finite(x):
+    """Every entry of x finite (FASTMATH keeps the NaN and infinity checks)."""
     for i in range(x.size):
         if not math.isfinite(x[i]):
             return False
@@ -118,7 +119,7 @@ def rk4_advance(x, t, h, nsteps, u, p, wp, wf, w, stats):
         rhs(ts + h, xt, u, p, wp, wf, k4, w)
         for i in range(m):
             x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-    if not _finite(x):
+    if not all_finite(x):
         return NONFINITE
     return OK
 
@@ -308,7 +309,7 @@ def si_advance(x, t, h, nsteps, u, p, wp, wf, w, stats):
         x[o + S_PSI] += h * (qq * sph + rr * cph) / cth
         x[o + S_REEL] += h * a[o + S_REEL]
         x[o + S_LENGTH] += h * x[o + S_REEL]
-    if not _finite(x):
+    if not all_finite(x):
         return NONFINITE
     return OK
 
