@@ -19,11 +19,10 @@ import argparse
 import warnings
 from collections import Counter
 
-import gymnasium as gym
 import numpy as np
 
 import aerostat_gym  # noqa: F401  (registers the environment)
-from aerostat_gym.bench.soak import STRESS_PERTURBATION
+from aerostat_gym.bench.soak import STRESS_PERTURBATION, reeling_ends
 from aerostat_gym.cli.common import output_dir, run_script, script_description
 from aerostat_gym.envs.batch import held_wind_top
 from aerostat_gym.params import (
@@ -32,7 +31,6 @@ from aerostat_gym.params import (
     load_params,
     tether_drag_step,
 )
-from aerostat_gym.registration import ENV_ID
 from aerostat_gym.scaling import scale_aerostat
 
 N_ENVS, STEPS, TOP_WIND, SPAN = 8, 500, 25.0, 8.0
@@ -50,18 +48,9 @@ def run(p, seed: int) -> tuple[Counter, tuple[float, float]]:
     """Terminations by reason of one aerostat's random-reeling run, and its wind range."""
     top = held_wind_top(p, 3.0, TOP_WIND)
     winds = (max(3.0, top - SPAN), top)
-    counts = Counter()
-    env = gym.make_vec(ENV_ID, num_envs=N_ENVS, vectorization_mode="vector_entry_point",
-                       params=p, wind_speed=winds, turbulence="severe", randomize=True,
-                       perturbation=STRESS_PERTURBATION)
-    env.reset(seed=seed)
-    rng = np.random.default_rng(seed)
-    for _ in range(STEPS):
-        _, _, _, _, info = env.step(rng.uniform(-1.5, 1.5, (N_ENVS, 1)).astype(np.float32))
-        if "termination" in info:
-            counts.update(info["termination"][info["_termination"]])
-    env.close()
-    return counts, winds
+    kwargs = {"params": p, "wind_speed": winds, "turbulence": "severe", "randomize": True,
+              "perturbation": STRESS_PERTURBATION}
+    return reeling_ends(kwargs, N_ENVS, STEPS, seed, amplitude=1.5), winds
 
 
 def main() -> None:

@@ -17,35 +17,20 @@ import argparse
 import warnings
 from collections import Counter
 
-import gymnasium as gym
-import numpy as np
-
 import aerostat_gym  # noqa: F401  (registers the environment)
-from aerostat_gym.bench.soak import STRESS_PERTURBATION
-from aerostat_gym.cli.common import run_script, script_description
-from aerostat_gym.registration import ENV_ID
+from aerostat_gym.bench.soak import STRESS_PERTURBATION, reeling_ends
+from aerostat_gym.cli.common import parse_overrides, run_script, script_description
 
 N_ENVS, STEPS = 8, 600
 
 
 def episode_ends(length: float, elements: int, wind: float, overrides: dict) -> Counter:
     """Terminations by reason over the random and the braked run at one wind speed."""
-    counts = Counter()
-    for braked in (False, True):
-        env = gym.make_vec(ENV_ID, num_envs=N_ENVS, vectorization_mode="vector_entry_point",
-                           tether_length=length, n_elements=elements, wind_speed=wind,
-                           turbulence="severe", perturbation=STRESS_PERTURBATION,
-                           overrides={"winch.min_length": min(30.0, length), **overrides})
-        env.reset(seed=0)
-        rng = np.random.default_rng(0)
-        for _ in range(STEPS):
-            action = np.zeros((N_ENVS, 1), np.float32) if braked else \
-                rng.uniform(-1.0, 1.0, (N_ENVS, 1)).astype(np.float32)
-            _, _, _, _, info = env.step(action)
-            if "termination" in info:
-                counts.update(info["termination"][info["_termination"]])
-        env.close()
-    return counts
+    kwargs = {"tether_length": length, "n_elements": elements, "wind_speed": wind,
+              "turbulence": "severe", "perturbation": STRESS_PERTURBATION,
+              "overrides": {"winch.min_length": min(30.0, length), **overrides}}
+    return sum((reeling_ends(kwargs, N_ENVS, STEPS, 0, amplitude) for amplitude in (1.0, 0.0)),
+               Counter())
 
 
 def main() -> None:
@@ -56,7 +41,7 @@ def main() -> None:
     ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                     help="parameter override, e.g. simulation.semi_implicit_dt=0.0125")
     args = ap.parse_args()
-    overrides = {k: float(v) for k, v in (s.split("=", 1) for s in args.set)}
+    overrides = parse_overrides(args.set)
     warnings.simplefilter("ignore")  # the winch-limit warnings of the strong winds
     print(f"{args.length:g} m on {args.elements} elements, severe turbulence, {N_ENVS} envs x "
           f"{STEPS} steps random + braked per wind speed {overrides or ''}")

@@ -87,6 +87,26 @@ def soak_configuration(cfg: dict, steps: int, num_envs: int, seed: int, counts: 
         env.close()
 
 
+def reeling_ends(env_kwargs: dict, num_envs: int, steps: int, seed: int,
+                 amplitude: float = 1.0) -> Counter:
+    """Episode terminations by reason (``info["termination"]``) of ``steps`` steps of a vector
+    environment made with ``env_kwargs``, reeled at random: actions uniform in [-amplitude,
+    amplitude] (0: the braked winch; above 1 the env clips them), seeded with ``seed``."""
+    counts = Counter()
+    env = TetheredAerostatVectorEnv(num_envs, **env_kwargs)
+    try:
+        env.reset(seed=seed)
+        rng = np.random.default_rng(seed)
+        for _ in range(steps):
+            actions = rng.uniform(-amplitude, amplitude, (num_envs, 1)).astype(np.float32)
+            _, _, _, _, info = env.step(actions)
+            if "termination" in info:
+                counts.update(info["termination"][info["_termination"]])
+    finally:
+        env.close()
+    return counts
+
+
 def _check_obs(obs, low, high, counts: Counter) -> None:
     counts["nonfinite_obs"] += int(np.count_nonzero(~np.isfinite(obs)))
     counts["obs_outside_space"] += int(np.count_nonzero((obs < low) | (obs > high)))
