@@ -318,6 +318,22 @@ def test_every_shipped_hyperparameter_file_passes_the_checks():
         assert norm["norm_obs"] is True and 0 < norm["gamma"] <= 1
 
 
+def test_a_shipped_hyperparameter_file_is_found_by_name(tmp_path, monkeypatch):
+    """From any directory, ``--hyperparams ppo_damping_noisy.yml`` is the shipped file (as
+    ``--config tcom_32m`` is a shipped configuration); a local file of that name wins; an
+    unknown name lists the shipped ones."""
+    monkeypatch.chdir(tmp_path)
+    task, _, _ = load_hyperparams("ppo", "ppo_damping_noisy.yml")
+    assert task == "TetheredAerostatDampingNoisy-v0"
+    local = tmp_path / "ppo_damping_noisy.yml"
+    local.write_text((shipped_root() / "hyperparams" / "ppo.yml").read_text())
+    assert load_hyperparams("ppo", "ppo_damping_noisy.yml")[0] == load_hyperparams("ppo")[0]
+    assert load_hyperparams("ppo")[0] != "TetheredAerostatDampingNoisy-v0"
+    with pytest.raises(TrainingError, match=r"not found: nope\.yml \(neither a file nor a "
+                       r"shipped one: ppo\.yml, .*sac\.yml"):
+        load_hyperparams("ppo", "nope.yml")
+
+
 # --- D12: the report directory -----------------------------------------------------------------
 
 def test_evaluate_checks_its_output_directory_before_evaluating(tmp_path, monkeypatch, capsys):

@@ -371,3 +371,11 @@ def test_time_limit_sets_no_truncation_reason_but_time():
     assert np.allclose(info["time"], 0.4) and info["_time"].all()
     _, rew, _, _, info = venv.step(np.zeros((2, 1)))  # NEXT_STEP: both slots reset
     assert np.all(rew == 0.0) and info["_wind_speed"].all() and "reward_effort" not in info
+
+
+def test_an_unknown_turbulence_preset_lists_every_valid_one():
+    """'config' (the parameter file's own turbulence) is valid too, so the refusal lists it."""
+    with pytest.raises(TaskError, match=re.escape(
+            "unknown turbulence preset 'lite'; choose one of ['none', 'light', 'moderate', "
+            "'severe', 'config']")):
+        gym.make(ENV_ID, turbulence="lite")

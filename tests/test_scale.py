@@ -20,7 +20,7 @@ from aerostat_gym.analysis.sensitivity import stability_figures as sensitivity_e
 from aerostat_gym.cli import main
 from aerostat_gym.envs.config import DEFAULT_RANDOMIZATION
 from aerostat_gym.params import ParameterError, load_params
-from aerostat_gym.scale.extra import MissingExtraError, require
+from aerostat_gym.extras import MissingExtraError, require
 from aerostat_gym.scale.mc_report import correlations, stability_table, stable_everywhere, summarize
 from aerostat_gym.scale.montecarlo import (
     MODES,
@@ -294,7 +294,33 @@ def test_without_the_extra_commands_exit_2_with_one_line(argv, tmp_path, monkeyp
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1, err
     assert err[0].startswith(f"aerostat-gym {argv[0]}: error: ")
-    assert "needs the optional 'ray' extra" in err[0] and 'pip install -e ".[ray]"' in err[0]
+    assert "needs the optional 'ray' extra" in err[0] and 'pip install "aerostat-gym[ray]"' in err[0]
+
+
+@pytest.mark.parametrize("argv, module, extra", [
+    (["evaluate", "--policy", "passive", "--out", "OUT"], "matplotlib", "plot"),
+    (["demo", "--out", "OUT"], "matplotlib", "plot"),
+    (["stability", "--wind", "5", "--plot", "OUT"], "matplotlib", "plot"),
+    (["wind", "--duration", "10", "--plot", "OUT/w.png"], "matplotlib", "plot"),
+    (["montecarlo", "--samples", "2", "--serial", "--out", "OUT"], "matplotlib", "plot"),
+    (["evaluate", "--policy", "shipped", "--no-plots", "--out", "OUT"], "stable_baselines3",
+     "train"),
+])
+def test_a_missing_extra_is_named_before_the_work(argv, module, extra, tmp_path, monkeypatch,
+                                                   capsys):
+    """A base install (no extras): each command that writes figures or loads a learned policy
+    names the extra to install in one line, exit status 2, before any work (no episode run,
+    nothing written), where it used to run its episodes and then fail with a traceback."""
+    monkeypatch.setitem(sys.modules, module, None)  # import -> ImportError
+    out = tmp_path / "out"
+    argv = [a.replace("OUT", str(out)) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert err[0].startswith(f"aerostat-gym {argv[0]}: error: ")
+    assert f"needs the optional '{extra}' extra" in err[0]
+    assert f'pip install "aerostat-gym[{extra}]"' in err[0]
+    assert not out.exists()
 
 
 def test_unreachable_cluster_is_one_line_exit_2(monkeypatch, capsys):
@@ -321,7 +347,7 @@ def test_serial_path_runs_without_ray(tmp_path, monkeypatch):
     assert summary["samples"] == 1 and summary["correlations"] == []  # one set: nothing to correlate
     assert summary["meta"]["configuration"] == "baseline --set tether.length=150"
     with pytest.raises(MissingExtraError, match="'ray' extra"):
-        require("ray", "x")
+        require("ray", "x", "ray")
 
 
 # --- tune ----------------------------------------------------------------------------------------------

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..analysis.linear import propagate
 from ..envs.vector import TetheredAerostatVectorEnv
+from ..extras import agg_pyplot
 from ..physics.state import S_X
 from .metrics import fit_damped_sinusoid
 from .metrics_drift import fit_pendulum_with_drift
@@ -384,10 +385,7 @@ def plot_frontier(rows: list[dict], limits: list[dict], out, max_speed: float = 
     matplotlib.figure.Figure
         The figure (closed to pyplot; its ``axes`` are the panels).
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = agg_pyplot("the frontier figure")
 
     speeds = sorted({float(r["wind_speed"]) for r in rows} | {float(b["wind_speed"])
                                                               for b in limits})

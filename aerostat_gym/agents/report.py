@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..checks import is_number
+from ..extras import agg_pyplot
 from ..resources import SHIPPED_POLICY
 from . import protocol as proto_mod
 from .evaluate import SCENARIOS, describe_suite, evaluate_policy
@@ -169,10 +170,7 @@ def score_and_damping(results: list[dict]) -> str:
 def plot_training_curve(history: list[dict], out: Path, title: str = "") -> Path:
     """The training curve: suite score (mean return on the evaluation suite) against
     environment steps and against wall time, from ``evaluations.json``'s records."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = agg_pyplot("the training curve")
 
     steps = np.array([h["timesteps"] for h in history], float)
     wall = np.array([h["wall_time_s"] for h in history], float)
@@ -196,10 +194,7 @@ def plot_training_curve(history: list[dict], out: Path, title: str = "") -> Path
 
 def plot(results: list[dict], out: Path) -> list[Path]:
     """Time histories of every policy overlaid (recover scenario) and damping ratios side by side."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = agg_pyplot("the report's plots (--no-plots skips them)")
 
     paths = []
     if "recover" not in results[0]["scenarios"]:

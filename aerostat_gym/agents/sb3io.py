@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..envs.spaces import N_OBS, as_batch
+from ..extras import require
 from .state_check import check_state_passed
 
 VECNORM_SUFFIX = "_vecnormalize.pkl"
@@ -289,6 +290,7 @@ def apply_deadband(action, deadband: float) -> np.ndarray:
 
 
 def _algorithms() -> list:
+    require("stable_baselines3", "a Stable-Baselines3 policy", "train")
     from stable_baselines3 import PPO, SAC, TD3
 
     algos = [PPO, SAC, TD3]

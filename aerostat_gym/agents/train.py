@@ -67,9 +67,10 @@ from ..checks import is_finite_number, is_whole
 from ..envs.batch import held_wind_top
 from ..envs.config import TaskConfig
 from ..envs.sb3 import sb3_vec_env
+from ..extras import require
 from ..params import as_params, dumps_toml
 from ..registration import TASKS
-from ..resources import shipped_path
+from ..resources import shipped_path, shipped_root
 from .asymmetric import actor_channels
 from .asymmetric import policy_class as asymmetric_policy_class
 from .evaluate import check_suite, held_suite_speeds, suite_score
@@ -104,16 +105,30 @@ class TrainingError(ValueError):
     """Bad training configuration (the message names the key or file)."""
 
 
+def _hyperparams_file(algo: str, path: str | Path | None) -> Path:
+    """The YAML file to read: ``path`` if it is a file, else a shipped file of that bare name
+    (``ppo_realistic.yml``, as ``--config`` takes a shipped name), default ``ALGO.yml``."""
+    if path is None:
+        return shipped_path("hyperparams", f"{algo}.yml")
+    given = Path(path)
+    if given.is_file():
+        return given
+    shipped = sorted(f.name for f in (shipped_root() / "hyperparams").glob("*.yml"))
+    if given.name == str(path) and given.name in shipped:
+        return shipped_root() / "hyperparams" / given.name
+    raise TrainingError(f"hyperparameter file not found: {path} (neither a file nor a shipped "
+                        f"one: {', '.join(shipped)})")
+
+
 def load_hyperparams(algo: str, path: str | Path | None = None) -> tuple[str, dict, dict]:
-    """(task id, zoo block, project block) of a hyperparameter YAML file (default: the shipped
-    ``hyperparams/ALGO.yml``). The zoo block is the one keyed by a registered task id."""
+    """(task id, zoo block, project block) of a hyperparameter YAML file (a path, or a shipped
+    file's name; default: the shipped ``hyperparams/ALGO.yml``). The zoo block is the one keyed
+    by a registered task id."""
     import yaml
 
     if algo not in ALGOS:
         raise TrainingError(f"unknown algorithm {algo!r}; choose one of {ALGOS}")
-    path = shipped_path("hyperparams", f"{algo}.yml") if path is None else Path(path)
-    if not path.is_file():
-        raise TrainingError(f"hyperparameter file not found: {path}")
+    path = _hyperparams_file(algo, path)
     try:
         data = yaml.safe_load(path.read_text()) or {}
     except yaml.YAMLError as exc:
@@ -399,6 +414,7 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
     evaluation (``record`` as in evaluations.json, plus ``"best"``: whether best_model.zip was
     just saved).
     """
+    require("stable_baselines3", "training", "train")
     import torch
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
     from stable_baselines3.common.utils import set_random_seed

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 from scipy.linalg import expm
 
+from ..extras import agg_pyplot
 from ..params import Params, load_params
 from ..sim import Model, simulate
 from .linear import linearize, propagate
@@ -26,12 +27,7 @@ FIG8_VARIABLES = (("x", "m"), ("y", "m"), ("z", "m"), ("phi", "rad"), ("theta", 
 
 
 def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    return agg_pyplot("the figures")
 
 
 # --- Figure 8 ------------------------------------------------------------------------------------

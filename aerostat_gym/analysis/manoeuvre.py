@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..extras import agg_pyplot
 from ..params import Params, load_params
 from ..physics.state import StateLayout
 from ..sim.simulate import simulate
@@ -68,10 +69,7 @@ def reel_manoeuvre(params: Params | None = None, wind_speed: float = 10.0, dista
 
 def plot_manoeuvre(result: Manoeuvre, path) -> None:
     """Length, reel speed, winch tension and aerostat altitude against time, into ``path``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = agg_pyplot("the manoeuvre figure")
 
     tr = result.trajectory
     fig, ax = plt.subplots(4, 1, figsize=(8, 9), sharex=True)

@@ -7,7 +7,7 @@ import sys
 import time
 
 from ..agents.evaluate import SUITES, cells_wind_range, suite_cells
-from ..agents.policies import BASELINES, load_policy
+from ..agents.policies import BASELINES, SHIPPED, load_policy
 from ..agents.report import (
     comparison_table,
     jsonable,
@@ -29,6 +29,7 @@ from .common import (
     output_dir,
     params_from_args,
     positive_int,
+    require_plotting,
     seed_int,
 )
 
@@ -39,7 +40,8 @@ def add_train_parser(sub) -> None:
                        f"(one of {', '.join(TASKS)}).")
     p.add_argument("--algo", choices=ALGOS, default="ppo", help="Stable-Baselines3 algorithm")
     p.add_argument("--hyperparams", metavar="YAML",
-                   help="rl-zoo3 hyperparameter file (default: the shipped hyperparams/ALGO.yml)")
+                   help="rl-zoo3 hyperparameter file, or a shipped one's name such as "
+                   "ppo_realistic.yml (default: the shipped ALGO.yml)")
     p.add_argument("--timesteps", type=positive_int,
                    help="total environment steps (default: the YAML's)")
     p.add_argument("--n-envs", type=positive_int, help="parallel environments (default: the YAML's)")
@@ -84,8 +86,9 @@ def add_evaluate_parser(sub) -> None:
 
 def _check_policies(names) -> None:
     """Refuse an unknown name or a missing or corrupt policy file before any work (the
-    baselines are designed per run, so only the learned policies are loaded here)."""
-    for name in names:
+    baselines are designed per run, so only the learned policies are loaded here; the shipped
+    ones last, so a mistyped path is named at once, not after a shipped policy's load)."""
+    for name in sorted(names, key=lambda n: n in SHIPPED):
         if name in BASELINES:
             continue
         try:
@@ -108,6 +111,8 @@ def _check_suite_winds(suite: str, speeds, params) -> None:
 
 
 def _evaluate_command(args) -> int:
+    if not args.no_plots:
+        require_plotting("evaluate's plots (--no-plots skips them)")
     _check_policies(args.policy)
     params = params_from_args(args)
     _check_suite_winds(args.suite, args.speeds, params)
@@ -148,6 +153,7 @@ def add_demo_parser(sub) -> None:
 
 def _demo_command(args) -> int:
     t0 = time.perf_counter()
+    require_plotting("the demo's report plots")
     _check_policies([args.policy])
     params = params_from_args(args)
     policies = ["passive", "lqr"]

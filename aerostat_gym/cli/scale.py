@@ -2,7 +2,7 @@
 
 The main CLI calls :func:`add_tune_parser` and :func:`add_montecarlo_parser`. Handlers return
 an exit status; bad input raises ValueError and a missing extra raises
-:class:`~aerostat_gym.scale.extra.MissingExtraError` (a RuntimeError), both of which the main
+:class:`~aerostat_gym.extras.MissingExtraError` (a RuntimeError), both of which the main
 CLI prints as one line and turns into exit status 2.
 """
 
@@ -17,14 +17,14 @@ from pathlib import Path
 import numpy as np
 
 from ..agents.train import ALGOS, load_hyperparams
+from ..extras import require
 from ..resources import shipped_path
 from ..scale.bench import format_throughput, throughput
-from ..scale.extra import require
 from ..scale.mc_report import summarize, write_outputs
 from ..scale.montecarlo import PERIOD_KEYS, SWEEP_SPEEDS, evaluate_sample, run_ray, run_serial
 from ..scale.ranges import RANGE_SOURCES, estimated_ranges
 from ..scale.tune import SCHEDULERS, SEARCHERS, SearchOptions, TrialSetup, load_space, run_search
-from .common import config_label, positive_float, positive_int, seed_int
+from .common import config_label, positive_float, positive_int, require_plotting, seed_int
 
 # the stability commands' parsing of --wind, --config and --set, shared rather than copied
 from .stability import parse_speeds
@@ -89,6 +89,8 @@ def _progress(done: int, n: int) -> None:
 
 def montecarlo_command(args: argparse.Namespace) -> int:
     """Run the study (or its throughput benchmark) and print the summary."""
+    if not (args.bench or args.no_plot):
+        require_plotting("the Monte Carlo figure (--no-plot skips it)")
     base = params_from_args(args)
     ranges = estimated_ranges(base, args.ranges)
     speeds = _speeds(args.wind)
@@ -242,9 +244,9 @@ def setup_from_args(args: argparse.Namespace) -> TrialSetup:
 
 def run_tune_command(args: argparse.Namespace) -> int:
     """``aerostat-gym tune``: run the search and print the per-configuration table."""
-    require("ray.tune", "the hyperparameter search (Ray Tune)")
-    require("optuna", "the hyperparameter search (Optuna)")
-    require("stable_baselines3", "training", extra="train")
+    require("ray.tune", "the hyperparameter search (Ray Tune)", "ray")
+    require("optuna", "the hyperparameter search (Optuna)", "ray")
+    require("stable_baselines3", "training", "train")
     setup = setup_from_args(args)
     opts = SearchOptions(args.configs, args.searcher, args.scheduler, args.search_seed,
                          args.cpus_per_trial, args.address, args.workers)

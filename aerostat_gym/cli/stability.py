@@ -35,7 +35,15 @@ from ..analysis.sensitivity import (
 )
 from ..analysis.trim import TrimLimitError, find_equilibrium, limit_warnings
 from ..params import MAX_WIND_SPEED
-from .common import add_config, output_dir, params_from_args, positive_float, positive_int, warn
+from .common import (
+    add_config,
+    output_dir,
+    params_from_args,
+    positive_float,
+    positive_int,
+    require_plotting,
+    warn,
+)
 
 #: the most wind speeds one sweep takes: 0.05 m/s steps over the model's whole 0-100 m/s
 MAX_SPEEDS = 2001
@@ -174,6 +182,7 @@ def held_speeds(params, speeds: np.ndarray) -> np.ndarray:
 def cmd_stability(args) -> int:
     params = stability_params(args)
     if args.plot:  # before the sweep: a long run never ends on a path it cannot write
+        require_plotting("--plot")
         output_dir(args.plot, "--plot")
     speeds = held_speeds(params, parse_speeds(args.wind))
     sweep = wind_sweep(params, speeds)

@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from ..agents.intensity import air_inertia_force
+from ..extras import agg_pyplot
 from ..params import MAX_WIND_SPEED
 from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
 from ..wind.field import build_wind, field_heights, field_times, mean_vector
@@ -38,6 +39,7 @@ from .common import (
     params_from_args,
     positive_float,
     positive_int,
+    require_plotting,
     seed_int,
 )
 
@@ -119,6 +121,7 @@ def _check_plot(args, cfg) -> None:
                  if _preset(args) == FROM_CONFIG else "")
         raise ValueError(f"--plot {args.plot}: no turbulence to plot{where}; choose a class "
                          f"with --preset ({', '.join(p for p in PRESETS if p != 'none')})")
+    require_plotting("--plot")
     output_file(args.plot, "--plot")
 
 
@@ -204,10 +207,7 @@ def _pair(realised: float, target: float) -> str:
 
 def _plot(path: str, cfg, wp, fields) -> None:
     """PNG with the u, v, w series, their PSDs against the analytic ones and the coherence."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = agg_pyplot("wind --plot")
 
     wf = np.stack(fields)
     dt, U = wp[W_FIELD_DT], wp[W_TAYLOR_U]

@@ -6,7 +6,7 @@ import os
 import time
 from dataclasses import dataclass
 
-from .extra import require
+from ..extras import require
 
 
 @dataclass
@@ -47,7 +47,7 @@ def start_ray(purpose: str, address: str | None = None, num_cpus: int | None = N
     :class:`RayStart`; an already initialised session (a test fixture) is reused as is.
     """
     t0 = time.perf_counter()
-    ray = require("ray", purpose, hint=hint)
+    ray = require("ray", purpose, "ray", hint=hint)
     import_s = time.perf_counter() - t0
     if ray.is_initialized():
         return RayStart(ray, False, import_s, 0.0, ray.cluster_resources().get("CPU", 0.0))

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..extras import agg_pyplot
 from .montecarlo import MODES, PERIOD_KEYS, Study
 from .stats import point_biserial, spearman, wilson_interval
 
@@ -217,10 +218,7 @@ def write_outputs(study: Study, summary: dict, out: Path, plot: bool = True) -> 
 def plot_study(study: Study, summary: dict, path: Path) -> Path:
     """Four panels: P(stable) against wind speed per mode, the Table 2 period histograms
     (relative to their medians), the smallest damping ratio, and the correlations."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = agg_pyplot("the Monte Carlo figure (--no-plot skips it)")
 
     fig, ax = plt.subplots(2, 2, figsize=(12, 8.5))
     _plot_probability(ax[0, 0], summary)

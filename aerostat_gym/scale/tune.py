@@ -39,8 +39,8 @@ from ..agents.protocol_stats import bootstrap_mean_ci
 from ..agents.sb3io import vecnormalize_path
 from ..agents.train import PROJECT_BLOCK, train
 from ..checks import is_whole
+from ..extras import require
 from .cluster import start_ray, stop_ray
-from .extra import require
 
 KINDS = ("uniform", "loguniform", "randint", "quniform", "choice")
 SEARCHERS = ("optuna", "random")
@@ -273,7 +273,7 @@ def _write_hp(path: Path, hp: dict, setup: TrialSetup) -> None:
 
 
 def _searcher(name: str, seed: int, repeat: int):
-    require("optuna", "the Optuna searcher")
+    require("optuna", "the Optuna searcher", "ray")
     import optuna
     from ray.tune.search import Repeater
     from ray.tune.search.optuna import OptunaSearch
@@ -339,7 +339,7 @@ def run_search(setup: TrialSetup, opts: SearchOptions, out: Path) -> dict:
                          f"{list(setup.seeds)}")
     start = start_ray("Ray Tune", opts.address, opts.workers)
     try:
-        tune = require("ray.tune", "Ray Tune")
+        tune = require("ray.tune", "Ray Tune", "ray")
         space, decode = tune_space(setup.space, tune)
         setup = TrialSetup(**{**setup.__dict__, "decode": frozenset(decode)})
         results = _fit(setup, opts, space, out.resolve())

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..params import Params
 from .field import build_wind
-from .presets import TurbulenceConfig, resolve_turbulence
+from .presets import PRESETS, TurbulenceConfig, resolve_turbulence
 
 #: Name of the turbulence argument that reads the parameter file's turbulence keys.
 FROM_CONFIG = "config"
@@ -78,6 +78,10 @@ def sized_turbulence(params: Params, turbulence=FROM_CONFIG) -> TurbulenceConfig
         cfg = resolve_turbulence(params.wind.turbulence)
         if params.wind.turbulence_model != cfg.model:
             cfg = cfg.replace(model=params.wind.turbulence_model)
+    elif isinstance(turbulence, str) and turbulence not in PRESETS:
+        raise ValueError(f"unknown turbulence preset {turbulence!r}; choose one of "
+                         f"{[*PRESETS, FROM_CONFIG]} ('{FROM_CONFIG}': the parameter file's "
+                         "wind.turbulence)")
     else:
         cfg = resolve_turbulence(turbulence)
     sized = {k: v for k, v in field_extent(params, cfg.dz).items() if k not in explicit}
