@@ -33,12 +33,17 @@ def _cli(args, cwd, timeout=900):
 
 
 def test_every_package_folder_is_installed():
-    """pyproject's explicit package list names every package folder under aerostat_gym/, and
-    the agents/ folder installs as aerostat_gym.shipped with its policy and hyperparameters."""
+    """pyproject's explicit package list names every package folder under aerostat_gym/ and
+    every data folder (aerostat_gym/data, agents/'s subfolders: setuptools drops a data folder
+    it is not given), and the agents/ folder installs as aerostat_gym.shipped with its policy
+    and hyperparameters."""
     cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
     listed = set(cfg["packages"])
     found = {".".join(p.parent.relative_to(ROOT).parts)
              for p in (ROOT / "aerostat_gym").rglob("__init__.py")}
+    found.add("aerostat_gym.data")
+    found |= {f"aerostat_gym.shipped.{d.name}" for d in (ROOT / "agents").iterdir()
+              if d.is_dir() and not d.name.startswith((".", "_"))}
     assert found <= listed, f"not installed: {sorted(found - listed)}"
     assert cfg["package-dir"]["aerostat_gym.shipped"] == "agents"
     for rel in (SHIPPED_POLICY, "ppo_tethered_aerostat_vecnormalize.pkl", "hyperparams/ppo.yml"):
