@@ -853,6 +853,20 @@ def test_a_small_aerostat_file_with_the_baseline_step_warns_at_load(tmp_path):
         assert advised_semi_implicit_dt(p) == pytest.approx(p.simulation.semi_implicit_dt, rel=1e-12)
 
 
+def test_the_small_aerostat_at_its_advised_step_smoke():
+    """The fast version of the slow test below: 4,000 of its random-action steps at the
+    advised step, every one counted, with no numerical failure, no non-finite observation or
+    reward and no observation outside the space."""
+    small = scale_aerostat(load_params(), volume_factor=0.1, tether_length=100.0)
+    cfg = {**VARIANTS[1], "integrator": "semi-implicit", "turbulence": "severe", "params": small}
+    counts = Counter()
+    soak_configuration(cfg, 4_000, 8, 0, counts)
+    assert counts["steps"] == 4_000
+    failures = {k: v for k, v in counts.items() if k.startswith("failure:")}
+    assert failures == {} and counts["nonfinite_obs"] == counts["nonfinite_reward"] == 0
+    assert counts["obs_outside_space"] == 0
+
+
 @pytest.mark.slow
 def test_the_advised_step_removes_the_small_aerostats_numerical_failures():
     """The numbers of the load warning: the baseline scaled to 0.1x on 100 m, the soak's
