@@ -111,7 +111,7 @@ class AerostatParams:
 @dataclass(frozen=True)
 class HullParams:
     l_h: float = _f("m", "ESTIMATE", POSITIVE, "nose to fin-root leading edge (hull region)")
-    I1: float = _f("m^2", "ESTIMATE", ANY, "Jones-DeLaurier integral I1 = A_h")
+    I1: float = _f("m^2", "ESTIMATE", NONNEG, "Jones-DeLaurier integral I1 = A_h")
     I3: float = _f("m^3", "ESTIMATE", ANY, "Jones-DeLaurier integral I3 = l_h A_h - V_h")
     J1: float = _f("m^2", "ESTIMATE", NONNEG, "side-projected area of the hull region")
     J2: float = _f("m^3", "ESTIMATE", ANY, "first moment of J1 about the nose")
@@ -328,7 +328,9 @@ def _build_panels(panels: Any) -> tuple:
 
 
 def _cross_checks(p: Params) -> None:
-    """Constraints between fields, checked after every load or override."""
+    """Constraints between fields, checked after every load or override (after the ranges of
+    single values no aerostat leaves, which the constraints' messages would otherwise print)."""
+    _check_ranges(p)
     if p.wind.turbulence not in TURBULENCE_PRESETS:
         raise ParameterError(f"wind.turbulence must be one of {TURBULENCE_PRESETS}, got {p.wind.turbulence!r}")
     if p.wind.turbulence_model not in TURBULENCE_MODELS:
@@ -338,6 +340,11 @@ def _cross_checks(p: Params) -> None:
         raise ParameterError(f"fins.post_stall must be one of {POST_STALL_MODELS}, got {p.fins.post_stall!r}")
     if p.wind.profile not in WIND_PROFILES:
         raise ParameterError(f"wind.profile must be one of {WIND_PROFILES}, got {p.wind.profile!r}")
+    if p.wind.profile == "log" and not p.wind.roughness_length < p.wind.reference_height:
+        raise ParameterError(
+            f"wind.roughness_length = {p.wind.roughness_length:g} m must be below "
+            f"wind.reference_height = {p.wind.reference_height:g} m for the log profile (its "
+            "speed, U ln(z / z0) / ln(z_ref / z0), would blow against the wind)")
     if p.winch.min_length >= p.winch.max_length:
         raise ParameterError(
             f"winch.min_length ({p.winch.min_length}) must be < winch.max_length ({p.winch.max_length})"
@@ -626,10 +633,37 @@ def check_limits(p: Params) -> None:
             "the ground strike read heights above the ground)")
 
 
+#: Bounds of single values that no aerostat on any planet leaves, (low, high, what is usual):
+#: past them the model fails far from the cause (a drag coefficient of 1e300 stalls the trim
+#: with a residual of 1e277, a damping ratio of 1e6 diverges every episode at its first step).
+PLAUSIBLE_RANGES = {
+    "environment.g": (0.1, 100.0, "m/s^2: Earth 9.81, Mars 3.7, Jupiter 24.8"),
+    "environment.rho_air": (1e-3, 100.0, "kg/m^3: 1.225 at sea level, 65 on Venus' surface"),
+    "tether.damping_ratio": (0.0, 2.0, "twice critical damping; [LN02] uses 0.017"),
+    "hull.CD0": (0.0, 2.0, "streamlined hulls 0.02-0.05 on V^(2/3), a blunt body about 1"),
+    "fins.CD0": (0.0, 2.0, "fin panels 0.008-0.02, a flat plate broadside 2"),
+    "fins.CL_alpha": (0.0, 4.0 * math.pi, "per radian: a thin airfoil 2 pi, low-aspect fins "
+                                          "1-3"),
+}
+
+
+def _check_ranges(p: Params) -> None:
+    """:data:`PLAUSIBLE_RANGES`, each an ImplausibleParameterError naming the field, with the
+    likely slip of a percentage where a hundredth of the value is in range."""
+    for key, (low, high, usual) in PLAUSIBLE_RANGES.items():
+        section, name = key.split(".")
+        value = getattr(getattr(p, section), name)
+        if not low <= value <= high:
+            raise ImplausibleParameterError(
+                f"{key} = {value:g} lies outside [{low:g}, {high:g}] ({usual})"
+                + _slip(value, {"a percentage written as a fraction": 0.01},
+                        lambda v, lo=low, hi=high: lo <= v <= hi))
+
+
 def check_plausibility(p: Params) -> None:
     """Refuse values that load but no real aerostat has (:class:`ImplausibleParameterError`),
     naming the field, the value, the bound and the likely slip. Run by :func:`load_params` and
-    when an environment is made."""
+    when an environment is made (:data:`PLAUSIBLE_RANGES` on every load and replace too)."""
     a, t, d = p.aerostat, p.tether, p.derived
     E = t.youngs_modulus
     # tether: its stretch under its own breaking strength and under the net lift
@@ -950,6 +984,14 @@ def as_params(p: Params | str | Path | None, error: type[ValueError] = Parameter
         return load_params(p)
     if not isinstance(p, Params):
         raise error(f"params must be a Params, a TOML path or None, got {type(p).__name__}")
+    return validated(p)
+
+
+def validated(p: Params) -> Params:
+    """``p`` after the loader's field and cross checks: a Params built with
+    ``dataclasses.replace`` (rather than :meth:`Params.replace`) skips them, and a zero
+    element count or a string for g would otherwise fail deep in the model."""
+    params_from_dict(params_to_dict(p))
     return p
 
 

@@ -6,6 +6,7 @@ library)."""
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -60,7 +61,7 @@ def test_a_numpy_count_is_accepted_where_a_python_one_is():
 
 @pytest.mark.parametrize("make, error, message", [
     (lambda: TetheredAerostatVectorEnv(num_envs=True), ValueError,
-     "num_envs must be an integer >= 1, got True"),
+     "num_envs must be an integer in [1, 65536], got True"),
     (lambda: TaskConfig.from_kwargs(wind_bank_size=True), TaskError,
      "wind_bank_size must be an integer >= 1, got True"),
     (lambda: TaskConfig.from_kwargs(wind_bank_seed=-1), TaskError,
@@ -75,7 +76,7 @@ def test_a_numpy_count_is_accepted_where_a_python_one_is():
      "resamples must be an integer >= 100, got True"),
 ])
 def test_a_bool_is_not_a_number_at_any_door(make, error, message):
-    with pytest.raises(error, match=message):
+    with pytest.raises(error, match=re.escape(message)):
         make()
 
 

@@ -379,3 +379,46 @@ def test_an_unknown_turbulence_preset_lists_every_valid_one():
             "unknown turbulence preset 'lite'; choose one of ['none', 'light', 'moderate', "
             "'severe', 'config']")):
         gym.make(ENV_ID, turbulence="lite")
+
+
+def test_a_params_rebuilt_with_dataclasses_replace_meets_the_loader_checks():
+    """dataclasses.replace skips Params.replace's checks; the environment runs them at make:
+    a zero element count and a string for g are named (were a ZeroDivisionError and a numpy
+    TypeError deep in the model), an eta_k of 5 refused (was accepted)."""
+    import dataclasses
+
+    from aerostat_gym.params import ParameterError, load_params
+    p = load_params()
+    cases = [(dataclasses.replace(p, tether=dataclasses.replace(p.tether, n_elements=0)),
+              "tether.n_elements must be an integer >= 1"),
+             (dataclasses.replace(p, environment=dataclasses.replace(p.environment, g="9.81")),
+              "environment.g must be a number, got '9.81'"),
+             (dataclasses.replace(p, hull=dataclasses.replace(p.hull, eta_k=5.0)),
+              "hull.eta_k must lie in [0, 1], got 5.0")]
+    for bad, message in cases:
+        with pytest.raises(ParameterError, match=re.escape(message)):
+            gym.make(ENV_ID, params=bad)
+
+
+def test_a_log_profile_needs_its_roughness_below_its_reference_height():
+    """ln(z / z0) / ln(z_ref / z0) with z0 >= z_ref turns the wind around (a reset failed on a
+    'turbulence speed -51.57'): refused where the file loads, naming both fields."""
+    from aerostat_gym.params import ParameterError
+    with pytest.raises(ParameterError, match=r"wind\.roughness_length = 20 m must be below "
+                       r"wind\.reference_height = 10 m"):
+        gym.make(ENV_ID, overrides={"wind.profile": "log", "wind.roughness_length": 20.0})
+
+
+def test_num_envs_is_bounded_before_anything_is_allocated():
+    """10**7 environments allocated 12.7 GB for minutes; the count is refused at once."""
+    with pytest.raises(ValueError, match=re.escape("num_envs must be an integer in [1, 65536], "
+                                                   "got 10000000")):
+        TetheredAerostatVectorEnv(num_envs=10**7)
+
+
+def test_a_randomisation_range_must_stay_plausible():
+    """rk4_safety 0.9 +- 60 % reaches 1.44, past the RK4 stability edge the loader refuses
+    (6 of 12 resets drew such values): refused at make."""
+    with pytest.raises(TaskError, match=r"reaches simulation\.rk4_safety = 1\.44, which the "
+                       r"loader refuses: simulation\.rk4_safety = 1\.44 exceeds 1\.02"):
+        gym.make(ENV_ID, randomize={"simulation.rk4_safety": 0.6}, integrator="rk4")

@@ -462,3 +462,27 @@ def test_a_tether_diameter_whose_area_overflows_is_named():
     infinite weight naming tether.diameter (was Python's OverflowError from the derived area)."""
     with pytest.raises(ParameterError, match=r"inf N, tether\.diameter"):
         load_params(overrides={"tether.diameter": 1e200})
+
+
+@pytest.mark.parametrize("over, message", [
+    ({"tether.damping_ratio": 1e6}, "tether.damping_ratio = 1e+06 lies outside [0, 2]"),
+    ({"hull.CD0": 1e300}, "hull.CD0 = 1e+300 lies outside [0, 2]"),
+    ({"hull.CD0": 2.9}, "; looks like a percentage written as a fraction"),
+    ({"fins.CL_alpha": 1e6}, "fins.CL_alpha = 1e+06 lies outside [0, 12.5664]"),
+    ({"environment.g": 1e-300}, "environment.g = 1e-300 lies outside [0.1, 100]"),
+    ({"environment.rho_air": 1e300}, "environment.rho_air = 1e+300 lies outside [0.001, 100]"),
+])
+def test_values_no_aerostat_has_are_named(over, message):
+    """PLAUSIBLE_RANGES: each refused on load naming the field (a CD0 of 1e300 stalled the trim
+    with a residual of 1e277, a damping ratio of 1e6 diverged every episode, an air density of
+    1e300 printed a 300-digit net lift); a ratio of 1.7 loads."""
+    with pytest.raises(ImplausibleParameterError) as err:
+        load_params(overrides=over)
+    assert message in str(err.value) and len(str(err.value)) < 200
+    assert load_params(overrides={"tether.damping_ratio": 1.7}).tether.damping_ratio == 1.7
+
+
+def test_a_negative_hull_area_integral_is_refused():
+    """I1 = A_h, the hull's cross-section area at the fins' root, cannot be negative."""
+    with pytest.raises(ParameterError, match=r"hull\.I1 must be >= 0, got -1\.0"):
+        load_params(overrides={"hull.I1": -1.0})

@@ -19,8 +19,8 @@ from aerostat_gym.analysis.sensitivity import DAMPING_SPEEDS, default_knobs
 from aerostat_gym.analysis.sensitivity import stability_figures as sensitivity_evaluate
 from aerostat_gym.cli import main
 from aerostat_gym.envs.config import DEFAULT_RANDOMIZATION
-from aerostat_gym.params import ParameterError, load_params
 from aerostat_gym.extras import MissingExtraError, require
+from aerostat_gym.params import ParameterError, load_params
 from aerostat_gym.scale.mc_report import correlations, stability_table, stable_everywhere, summarize
 from aerostat_gym.scale.montecarlo import (
     MODES,
@@ -86,8 +86,9 @@ def test_draws_are_uniform_in_their_ranges():
     z = (x.mean(axis=0) - (lo + hi) / 2) / ((hi - lo) / math.sqrt(12 * n))
     assert np.all(np.abs(z) < 4.0), z
     np.testing.assert_array_equal(x, draw_values(ranges, n, seed=3))
-    with pytest.raises(ValueError, match="--samples must be an integer >= 1"):
-        draw_values(ranges, 0, seed=0)
+    for bad in (0, 10**9):  # above MAX_SAMPLES: refused before the arrays are allocated
+        with pytest.raises(ValueError, match=r"--samples must be an integer in \[1, 1000000\]"):
+            draw_values(ranges, bad, seed=0)
 
 
 # --- the per-sample function ------------------------------------------------------------------------

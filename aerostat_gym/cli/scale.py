@@ -21,7 +21,14 @@ from ..extras import require
 from ..resources import shipped_path
 from ..scale.bench import format_throughput, throughput
 from ..scale.mc_report import summarize, write_outputs
-from ..scale.montecarlo import PERIOD_KEYS, SWEEP_SPEEDS, evaluate_sample, run_ray, run_serial
+from ..scale.montecarlo import (
+    PERIOD_KEYS,
+    SWEEP_SPEEDS,
+    check_samples,
+    evaluate_sample,
+    run_ray,
+    run_serial,
+)
 from ..scale.ranges import RANGE_SOURCES, estimated_ranges
 from ..scale.tune import SCHEDULERS, SEARCHERS, SearchOptions, TrialSetup, load_space, run_search
 from .common import config_label, positive_float, positive_int, require_plotting, seed_int
@@ -89,6 +96,7 @@ def _progress(done: int, n: int) -> None:
 
 def montecarlo_command(args: argparse.Namespace) -> int:
     """Run the study (or its throughput benchmark) and print the summary."""
+    check_samples(args.samples)
     if not (args.bench or args.no_plot):
         require_plotting("the Monte Carlo figure (--no-plot skips it)")
     base = params_from_args(args)

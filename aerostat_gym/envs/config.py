@@ -224,8 +224,10 @@ def turbulence_mix(spec, turb, given) -> tuple[tuple[str, ...], np.ndarray] | No
 
 
 def _check_range_ends(params: Params, key: str, rel: float) -> None:
-    """Both ends of a randomisation range must load: a range whose end is infeasible (no net
-    lift, a tether length outside the winch's limits, ...) is refused when the env is made.
+    """Both ends of a randomisation range must load and be plausible: a range whose end is
+    infeasible (no net lift, a tether length outside the winch's limits, ...) or past the
+    loader's plausibility bounds (an RK4 safety factor beyond its measured stability edge) is
+    refused when the env is made.
     The inertia constraints are joint (an Iyy that is too large with the nominal Izz is a body
     with a larger Izz): :func:`_check_inertia_draws` checks them over the drawn combinations."""
     value = get_parameter(params, key)
@@ -233,7 +235,7 @@ def _check_range_ends(params: Params, key: str, rel: float) -> None:
         raise TaskError(f"randomize[{key!r}] must name a scalar number parameter, got {value!r}")
     for end in (1.0 - rel, 1.0 + rel):
         try:
-            apply_overrides(params, {key: value * end})
+            check_plausibility(apply_overrides(params, {key: value * end}))
         except InertiaError:
             pass
         except ParameterError as exc:

@@ -23,7 +23,7 @@ from gymnasium.vector.utils import batch_space
 from ..checks import is_whole
 from ..sim.events import FAILURES, FIELD_END, OUTCOMES, RUNNING
 from . import reward
-from .batch import EnvBatch
+from .batch import EnvBatch, check_num_envs
 from .config import TaskConfig, TaskError
 from .env import frame
 from .episodes import reset_options
@@ -65,8 +65,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
     def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
                  render_mode: str | None = None, threads: int | None = None, **kwargs):
-        if not is_whole(num_envs):
-            raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
+        check_num_envs(num_envs)
         self.autoreset_mode = AutoresetMode(autoreset_mode)
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"unknown render_mode {render_mode!r}; the vector env renders "

@@ -89,6 +89,9 @@ def pack_wind(profile: str = "uniform", speed: float = 0.0, direction_deg: float
         raise ValueError(f"unknown wind profile {profile!r}; choose one of {sorted(PROFILES)}")
     if not (math.isfinite(speed) and speed >= 0):
         raise ValueError(f"wind speed must be finite and >= 0, got {speed!r}")
+    if profile == "log" and not roughness_length < reference_height:
+        raise ValueError(f"the log profile needs a roughness length ({roughness_length:g} m) "
+                         f"below its reference height ({reference_height:g} m)")
     wp = np.zeros(W_SIZE)
     wp[W_PROFILE] = PROFILES[profile]
     wp[W_UREF] = speed

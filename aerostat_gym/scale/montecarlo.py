@@ -110,9 +110,14 @@ def _uniform(rng: np.random.Generator, ranges: list[ParameterRange], rows: int) 
     return low + u * (high - low)
 
 
-def _check_samples(n) -> None:
-    if not is_whole(n):
-        raise ValueError(f"--samples must be an integer >= 1, got {n!r}")
+#: Most parameter sets one study draws (each keeps its periods, damping ratios and margins at
+#: every wind speed: a million sets of the default sweep is about 1 GB).
+MAX_SAMPLES = 1_000_000
+
+
+def check_samples(n) -> None:
+    if not is_whole(n) or n > MAX_SAMPLES:
+        raise ValueError(f"--samples must be an integer in [1, {MAX_SAMPLES}], got {n!r}")
 
 
 def draw_values(ranges: list[ParameterRange], n: int, seed: int) -> np.ndarray:
@@ -124,7 +129,7 @@ def draw_values(ranges: list[ParameterRange], n: int, seed: int) -> np.ndarray:
     n : number of parameter sets.
     seed : seed of the generator.
     """
-    _check_samples(n)
+    check_samples(n)
     return _uniform(np.random.default_rng(seed), ranges, n)
 
 
@@ -143,7 +148,7 @@ def draw_valid(base: Params, ranges: list[ParameterRange], n: int,
     values : (n, len(ranges)) drawn values, in range order.
     rejected : the loader's message for every draw redrawn, in draw order.
     """
-    _check_samples(n)
+    check_samples(n)
     rng = np.random.default_rng(seed)
     kept: list[np.ndarray] = []
     rejected: list[str] = []
