@@ -112,7 +112,9 @@ def test_the_wind_speed_ends_where_the_incompressible_model_does():
 
 @pytest.mark.parametrize("make, error, message", [
     (lambda: evaluate_policy("passive", control_step=0), TaskError,
-     r"control_step must be a number in \(0, 1\] s .* got 0"),
+     r"control_step must be a number in \[0.001, 1\] s .* got 0"),
+    (lambda: TaskConfig.from_kwargs(control_step=5e-324), TaskError,  # overflowed the step count
+     r"control_step must be a number in \[0.001, 1\] s .* got 5e-324"),
     (lambda: load_policy("lqr", dt="0.2"), TaskError, "control_step must be a number"),
     (lambda: load_policy(None), PolicyError, "a policy is a baseline's name, 'shipped' or a "
                                              "path to a .zip, got None"),
@@ -128,3 +130,12 @@ def test_a_policy_path_may_be_a_path_object():
     by_path = load_policy(shipped_path(SHIPPED_POLICY))
     by_name = load_policy("shipped")
     assert np.array_equal(by_path.predict(obs)[0], by_name.predict(obs)[0])
+
+
+def test_numpy_scalars_and_0_d_arrays_are_numbers_at_the_env_door():
+    """np.array(10.0) is the number it holds (was a TypeError from len()); a float32
+    randomisation half-range is a number (was refused)."""
+    task = TaskConfig.from_kwargs(wind_speed=np.array(10.0))
+    assert task.resolved["wind_speed"] == (10.0, 10.0)
+    spec = TaskConfig.from_kwargs(randomize={"aerostat.mass": np.float32(0.01)}).resolved
+    assert spec["randomize"]["aerostat.mass"] == pytest.approx(0.01)

@@ -422,3 +422,22 @@ def test_a_randomisation_range_must_stay_plausible():
     with pytest.raises(TaskError, match=r"reaches simulation\.rk4_safety = 1\.44, which the "
                        r"loader refuses: simulation\.rk4_safety = 1\.44 exceeds 1\.02"):
         gym.make(ENV_ID, randomize={"simulation.rk4_safety": 0.6}, integrator="rk4")
+
+
+def test_a_reward_fn_must_take_three_arguments_and_return_a_number():
+    """A reward_fn without the (obs, action, info) signature is named at make (was a TypeError
+    at the first step); "1" and True are not rewards (were read as 1.0); a NumPy scalar and a
+    0-d array are the numbers they hold."""
+    with pytest.raises(TaskError, match=re.escape("reward_fn must take three arguments f(obs, "
+                                                  "action, info), got <lambda>()")):
+        gym.make(ENV_ID, reward_fn=lambda: 0.0)
+    for bad in ("1", True):
+        env = gym.make(ENV_ID, reward_fn=lambda o, a, i, bad=bad: bad)
+        env.reset(seed=0)
+        with pytest.raises(ValueError, match=re.escape(f"reward_fn must return a number, got "
+                                                       f"{bad!r}")):
+            env.step(np.zeros(1, np.float32))
+    for good, value in ((np.float32(2.0), 2.0), (np.array(3.0), 3.0)):
+        env = gym.make(ENV_ID, reward_fn=lambda o, a, i, good=good: good)
+        env.reset(seed=0)
+        assert env.step(np.zeros(1, np.float32))[1] == value

@@ -66,6 +66,8 @@ class TaskError(ValueError):
 def check_range(name, value, lo_min=0.0, hi_max=math.inf):
     """A (low, high) range in [lo_min, hi_max]; a single number is the fixed value (value,
     value)."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:  # np.array(10.0): the number it holds
+        value = value.item()
     pair = (value, value) if is_number(value) else value
     if not (isinstance(pair, (tuple, list, np.ndarray)) and len(pair) == 2
             and all(is_number(v) for v in pair)):  # "12" is no pair; True is no number
@@ -78,13 +80,18 @@ def check_range(name, value, lo_min=0.0, hi_max=math.inf):
     return lo, hi
 
 
+#: [s] the shortest control step: a millisecond is shorter than any integration step the
+#: model takes on a real aerostat (5e-324 s overflowed the step count)
+MIN_CONTROL_STEP = 1e-3
+
+
 def check_control_step(value) -> float:
     """The control step [s]: a finite number in (0, 1] (a reel command held longer than 1 s
     cannot act on the pitch and axial-spring modes, ~3 s on the baseline)."""
-    if not (is_finite_number(value) and 0 < value <= 1.0):
-        raise TaskError(f"control_step must be a number in (0, 1] s (a reel command held "
-                        f"longer cannot act on the pitch and axial modes, ~3 s on the "
-                        f"baseline), got {value!r}")
+    if not (is_finite_number(value) and MIN_CONTROL_STEP <= value <= 1.0):
+        raise TaskError(f"control_step must be a number in [{MIN_CONTROL_STEP:g}, 1] s (a reel "
+                        f"command held longer cannot act on the pitch and axial modes, ~3 s on "
+                        f"the baseline), got {value!r}")
     return float(value)
 
 
@@ -178,7 +185,7 @@ class TaskConfig:
         if not isinstance(spec, dict):
             raise TaskError(f"randomize must be None, True or a dict, got {self.randomize!r}")
         for key, rel in spec.items():
-            if not (isinstance(rel, (int, float)) and 0 <= rel < 1):
+            if not (is_number(rel) and 0 <= rel < 1):
                 raise TaskError(f"randomize[{key!r}] must be a relative half-range in [0, 1), "
                                 f"got {rel!r}")
             _check_range_ends(params, key, rel)

@@ -41,13 +41,14 @@ default is a few hundred nanoseconds; a Python ``reward_fn`` costs a Python call
 
 from __future__ import annotations
 
+import inspect
 import math
 from collections.abc import Callable, Mapping
 
 import numpy as np
 from numba import njit
 
-from ..checks import is_finite_number
+from ..checks import is_finite_number, is_number
 from ..physics.core import FASTMATH
 from ..sim.events import FIELD_END, RUNNING
 from .spaces import (
@@ -140,16 +141,26 @@ def check_reward_fn(fn) -> RewardFn | None:
     if fn is not None and not callable(fn):
         raise ValueError(f"reward_fn must be a callable f(obs, action, info) -> float, got "
                          f"{type(fn).__name__}")
+    if fn is not None:
+        try:
+            inspect.signature(fn).bind(None, None, None)
+        except TypeError:
+            raise ValueError(f"reward_fn must take three arguments f(obs, action, info), got "
+                             f"{getattr(fn, '__name__', type(fn).__name__)}"
+                             f"{inspect.signature(fn)}") from None
+        except ValueError:  # no signature to read (some builtins): the first call will tell
+            pass
     return fn
 
 
 def custom_reward(fn: RewardFn, obs: np.ndarray, action: float, info: dict) -> float:
     """Call a user reward and check its value (a finite float, else a ValueError)."""
     r = fn(obs, action, info)
-    try:
-        value = float(r)
-    except (TypeError, ValueError):
-        raise ValueError(f"reward_fn must return a number, got {type(r).__name__}") from None
+    if isinstance(r, np.ndarray) and r.ndim == 0:
+        r = r.item()
+    if not is_number(r):  # "1" and True are no rewards
+        raise ValueError(f"reward_fn must return a number, got {r!r}")
+    value = float(r)
     if not math.isfinite(value):
         raise ValueError(f"reward_fn returned a non-finite reward {value!r}")
     return value
