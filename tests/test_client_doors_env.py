@@ -441,3 +441,19 @@ def test_a_reward_fn_must_take_three_arguments_and_return_a_number():
         env = gym.make(ENV_ID, reward_fn=lambda o, a, i, good=good: good)
         env.reset(seed=0)
         assert env.step(np.zeros(1, np.float32))[1] == value
+
+
+def test_the_sb3_adapter_names_a_bad_seed_and_an_unknown_attribute():
+    """seed('x') and seed(-1) are refused at the call (were an SB3 TypeError, and a refusal at
+    the next reset); get_attr of an unknown name is an AttributeError, as DummyVecEnv's (was
+    a list of None)."""
+    from aerostat_gym.envs import sb3_vec_env
+    venv = sb3_vec_env(2)
+    for bad in ("x", -1):
+        with pytest.raises(ValueError, match=re.escape(f"seed must be None or an integer >= 0, "
+                                                       f"got {bad!r}")):
+            venv.seed(bad)
+    with pytest.raises(AttributeError, match="bogus"):
+        venv.get_attr("bogus")
+    assert venv.get_attr("num_envs") == [2, 2]
+    venv.close()

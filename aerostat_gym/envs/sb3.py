@@ -67,6 +67,10 @@ def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
             if seed is not None:
                 self.seed(seed)
 
+        def seed(self, seed=None):
+            check_seed(seed)  # at the call, as sb3_vec_env(seed=...): not at the next reset
+            return super().seed(seed)
+
         def set_options(self, options=None) -> None:
             self._options = check_set_options(options, self.num_envs)
 
@@ -112,7 +116,8 @@ def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
             self.venv.close()
 
         def get_attr(self, attr_name, indices=None):
-            return [getattr(self.venv, attr_name, None) for _ in self._get_indices(indices)]
+            value = getattr(self.venv, attr_name)  # AttributeError naming it, as DummyVecEnv
+            return [value for _ in self._get_indices(indices)]
 
         def set_attr(self, attr_name, value, indices=None):
             setattr(self.venv, attr_name, value)
