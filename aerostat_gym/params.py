@@ -973,6 +973,8 @@ def load_params(path: str | Path | None = None, overrides: dict[str, Any] | None
     p = apply_overrides(p, overrides) if overrides else p
     check_plausibility(p)
     _advise(p, source)
+    for slip in status_slips(text):
+        warnings.warn(f"{source}: {slip}", ParameterWarning, stacklevel=2)
     return p
 
 
@@ -1019,6 +1021,30 @@ def status_comments(text: str) -> dict[str, str]:
         found = [w.strip("(),:;") for w in comment.split() if w.strip("(),:;") in STATUSES]
         if found:
             out[f"{section}.{body.split('=', 1)[0].strip()}"] = found[0]
+    return out
+
+
+def status_slips(text: str) -> list[str]:
+    """A warning text for every parameter line whose comment has no status word but a word
+    close to one (``SORCED``, ``ESTIMATED``, ``CALIBRATED``): the value would silently keep
+    the baseline's status, or USER."""
+    out = []
+    for number, line in enumerate(text.splitlines(), 1):
+        body, _, comment = line.partition("#")
+        if "=" not in body or not comment:
+            continue
+        words = [w.strip("(),:;.") for w in comment.split()]
+        if any(w in STATUSES for w in words):
+            continue
+        for w in words:
+            near = [s for s in STATUSES if len(w) >= 4 and w.isupper()
+                    and (w.startswith(s) or difflib.SequenceMatcher(None, w, s).ratio() >= 0.75)]
+            if near:
+                out.append(f"line {number}: {w!r} is no status word (did you mean {near[0]!r}? "
+                           f"one of {', '.join(STATUSES)}); "
+                           f"{body.split('=', 1)[0].strip()} takes the baseline's status (USER "
+                           "where its value differs)")
+                break
     return out
 
 

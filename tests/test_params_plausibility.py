@@ -11,9 +11,11 @@ from __future__ import annotations
 import math
 import re
 import warnings
+from pathlib import Path
 
 import pytest
 
+import aerostat_gym
 from aerostat_gym.analysis.trim import REL_TOL, TrimError, find_equilibrium
 from aerostat_gym.params import (
     MAX_WIND_SPEED,
@@ -486,3 +488,21 @@ def test_a_negative_hull_area_integral_is_refused():
     """I1 = A_h, the hull's cross-section area at the fins' root, cannot be negative."""
     with pytest.raises(ParameterError, match=r"hull\.I1 must be >= 0, got -1\.0"):
         load_params(overrides={"hull.I1": -1.0})
+
+
+def test_a_misspelt_status_word_warns_naming_the_line(tmp_path):
+    """A status comment with SORCED, ESTIMATED or CALIBRATED would silently report the value
+    with the baseline's status: a ParameterWarning names the line, the word and the nearest
+    status; the shipped files have none."""
+    base = (Path(aerostat_gym.__file__).parent / "data" / "aeros_flightcam.toml").read_text()
+    lines = base.splitlines()
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("mass ="))
+    lines[k] = lines[k].replace("DERIVED", "DERIVD")
+    path = tmp_path / "slip.toml"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.warns(ParameterWarning, match=rf"line {k + 1}: 'DERIVD' is no status word "
+                      r"\(did you mean 'DERIVED'\?"):
+        load_params(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        load_params()
