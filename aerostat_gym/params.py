@@ -947,6 +947,9 @@ def _config_text(path: str | Path | None) -> tuple[str, str]:
     if not Path(path).is_file() and str(path) in shipped_configs():
         return resources.files("aerostat_gym").joinpath(f"data/{path}.toml").read_text(), str(path)
     path = Path(path)
+    if path.is_dir():
+        raise ParameterError(f"{path} is a folder: give a parameter file (.toml) in it, or a "
+                             f"shipped configuration ({', '.join(shipped_configs())})")
     if not path.is_file():
         raise ParameterError(f"parameter file not found: {path} (shipped configurations: "
                              f"{', '.join(shipped_configs())})")

@@ -391,3 +391,18 @@ def test_demo_takes_a_baseline_it_already_runs_and_prints_every_scenario(tmp_pat
     assert "\nrecover:\n" in out and "\ngusty:\n" in out
     rows = [line.split("|")[1:3] for line in out.splitlines() if line.startswith("| 10 |")]
     assert [policy.strip() for _, policy in rows] == ["passive", "lqr", "passive", "lqr"]
+
+
+def test_a_hyperparameter_file_that_is_not_utf8_is_named(tmp_path):
+    path = tmp_path / "latin1.yml"
+    path.write_bytes("TetheredAerostat-v0:\n  # caf\xe9\n  n_envs: 4\n".encode("latin-1"))
+    with pytest.raises(TrainingError, match=rf"{re.escape(str(path))}: not UTF-8 text: byte "
+                       r"0xe9"):
+        load_hyperparams("ppo", path)
+
+
+def test_a_folder_given_as_the_parameter_file_is_named(tmp_path):
+    from aerostat_gym.params import ParameterError, load_params
+    with pytest.raises(ParameterError, match=rf"{re.escape(str(tmp_path))} is a folder: give a "
+                       r"parameter file"):
+        load_params(tmp_path)

@@ -130,7 +130,10 @@ def load_hyperparams(algo: str, path: str | Path | None = None) -> tuple[str, di
         raise TrainingError(f"unknown algorithm {algo!r}; choose one of {ALGOS}")
     path = _hyperparams_file(algo, path)
     try:
-        data = yaml.safe_load(path.read_text()) or {}
+        data = yaml.safe_load(path.read_bytes().decode("utf-8-sig")) or {}
+    except UnicodeDecodeError as exc:
+        raise TrainingError(f"{path}: not UTF-8 text: byte {exc.object[exc.start]:#04x} at "
+                            f"offset {exc.start}") from None
     except yaml.YAMLError as exc:
         where = getattr(exc, "problem_mark", None)
         line = f" (line {where.line + 1})" if where is not None else ""
