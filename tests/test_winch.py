@@ -340,3 +340,12 @@ def test_winch_events_and_load_cell(base, trim10):
     assert tr.thresholds == {"slack_tension": T_trim - 300.0, "safe_working_load": T_trim + 300.0,
                              "strength": 35.6e3}
     assert tr.status == "ok"
+
+
+def test_a_manoeuvre_past_the_winch_limits_is_refused_at_the_door(base):
+    """1e9 m of reel-out ran for minutes; a negative hold ran and said 'ok': both named."""
+    with pytest.raises(ValueError, match=r"distance must keep the tether within the winch's "
+                       r"limits \[150, 400\] m from the trim's 300 m: \[-150, 100\] m"):
+        reel_manoeuvre(base, 10.0, 1e9)
+    with pytest.raises(ValueError, match=r"hold must be a finite time >= 0 s, got -1"):
+        reel_manoeuvre(base, 10.0, -50.0, hold=-1.0)

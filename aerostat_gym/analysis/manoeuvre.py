@@ -52,9 +52,17 @@ def reel_manoeuvre(params: Params | None = None, wind_speed: float = 10.0, dista
     speed = params.winch.max_speed if speed is None else float(speed)
     if not (math.isfinite(speed) and speed > 0):
         raise ValueError(f"speed must be finite and > 0, got {speed!r}")
+    for name, value in (("hold", hold), ("settle", settle)):
+        if not (math.isfinite(value) and value >= 0):
+            raise ValueError(f"{name} must be a finite time >= 0 s, got {value!r}")
     eq = find_equilibrium(params, wind_speed)
     iL = StateLayout(params.tether.n_elements).winch_length
     L0 = float(eq.x[iL])
+    w = params.winch
+    if not (math.isfinite(distance) and w.min_length <= L0 + distance <= w.max_length):
+        raise ValueError(f"distance must keep the tether within the winch's limits "
+                         f"[{w.min_length:g}, {w.max_length:g}] m from the trim's {L0:g} m: "
+                         f"[{w.min_length - L0:g}, {w.max_length - L0:g}] m, got {distance!r}")
     t_in = distance / speed + hold
 
     def target(t):
