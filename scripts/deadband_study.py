@@ -30,7 +30,7 @@ from aerostat_gym.agents.evaluate import SENSOR_NOISE, suite_result
 from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.agents.report import load_results, policy_labels
 from aerostat_gym.agents.residual import ShapedPolicy
-from aerostat_gym.cli.common import run_script, script_description
+from aerostat_gym.cli.common import nonneg_float, run_script, script_description
 from aerostat_gym.params import load_params
 
 #: (scenario, wind speed, metric) of the printed key-cell columns.
@@ -51,9 +51,9 @@ def main(argv=None) -> list[dict]:
     ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--policy", action="append", default=None, metavar="NAME_OR_PATH",
                     help="a policy for load_policy (repeatable; default: shipped)")
-    ap.add_argument("--deadband", type=float, default=0.05,
+    ap.add_argument("--deadband", type=nonneg_float, default=0.05,
                     help="deadband as a fraction of the winch's top speed (default 0.05)")
-    ap.add_argument("--lowpass", type=float, default=0.0,
+    ap.add_argument("--lowpass", type=nonneg_float, default=0.0,
                     help="command low-pass time constant [s] (default 0: none)")
     ap.add_argument("--shaped", action="append", default=None, metavar="NAME_OR_PATH",
                     help="the policies also run with the deadband and low-pass (repeatable; "

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 
+from aerostat_gym.agents.evaluate import SCENARIOS
 from aerostat_gym.agents.pitch_check import check_markdown, linear_pitch_check
 from aerostat_gym.agents.report import emit_table
 from aerostat_gym.cli.common import run_script, script_description
@@ -22,7 +23,8 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--config", default=None, help="parameter TOML (default: the baseline)")
     ap.add_argument("--speeds", nargs="+", type=float, default=[5.0, 10.0, 15.0])
-    ap.add_argument("--scenarios", nargs="+", default=["recover", "recover_small"])
+    ap.add_argument("--scenarios", nargs="+", default=["recover", "recover_small"],
+                    choices=[name for name, s in SCENARIOS.items() if s.free])
     ap.add_argument("--markdown", default=None, help="write the table here")
     ap.add_argument("--json", default=None, help="write the rows here")
     args = ap.parse_args(argv)

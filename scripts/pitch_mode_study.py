@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 
-from aerostat_gym.agents.evaluate import REPORT_SEEDS, SENSOR_NOISE
+from aerostat_gym.agents.evaluate import REPORT_SEEDS, SCENARIOS, SENSOR_NOISE
 from aerostat_gym.agents.pitch_check import pitching_mode_study, study_markdown
 from aerostat_gym.agents.report import emit_table
 from aerostat_gym.cli.common import run_script, script_description
@@ -22,7 +22,7 @@ from aerostat_gym.params import load_params
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=script_description(__doc__))
     ap.add_argument("--config", default=None, help="parameter TOML (default: the baseline)")
-    ap.add_argument("--scenario", default="recover")
+    ap.add_argument("--scenario", default="recover", choices=list(SCENARIOS))
     ap.add_argument("--speeds", nargs="+", type=float, default=[5.0, 10.0, 15.0])
     ap.add_argument("--policies", nargs="+", default=["passive", "shipped"],
                     help="policy names or saved models; the first is the reference")

@@ -21,7 +21,11 @@ def main(argv=None) -> None:
     ap.add_argument("protocol_json", help="protocol.json written by aerostat-gym evaluate")
     args = ap.parse_args(argv)
     with open(args.protocol_json) as fh:
-        print(condensed(json.load(fh)))
+        data = json.load(fh)
+    if not (isinstance(data, dict) and "cells" in data):
+        raise ValueError(f"{args.protocol_json}: not a protocol.json written by aerostat-gym "
+                         "evaluate (no 'cells')")
+    print(condensed(data))
 
 
 if __name__ == "__main__":

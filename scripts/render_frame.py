@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import aerostat_gym  # noqa: F401  (registers the environment)
-from aerostat_gym.cli.common import run_script, script_description
+from aerostat_gym.cli.common import positive_int, run_script, script_description, seed_int
 
 
 def main(argv=None) -> int:
@@ -23,8 +23,9 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent.parent / "docs" / "img"
                                          / "frame.png"),
                     help="PNG file to write (default: the README's docs/img/frame.png)")
-    ap.add_argument("--seed", type=int, default=0, help="episode seed")
-    ap.add_argument("--steps", type=int, default=60, help="braked-winch steps before the frame")
+    ap.add_argument("--seed", type=seed_int, default=0, help="episode seed")
+    ap.add_argument("--steps", type=positive_int, default=60,
+                    help="braked-winch steps before the frame")
     args = ap.parse_args(argv)
     env = gym.make("TetheredAerostat-v0", render_mode="rgb_array")
     env.reset(seed=args.seed, options={"wind_speed": 10.0})

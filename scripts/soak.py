@@ -9,14 +9,15 @@ from __future__ import annotations
 import argparse
 
 from aerostat_gym.bench.soak import format_report, memory_check, run_soak
-from aerostat_gym.cli.common import run_script, script_description
+from aerostat_gym.cli.common import positive_int, run_script, script_description, seed_int
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=script_description(__doc__))
-    ap.add_argument("--steps", type=int, default=1_000_000, help="total env steps")
-    ap.add_argument("--num-envs", type=int, default=8, help="vector env size per configuration")
-    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--steps", type=positive_int, default=1_000_000, help="total env steps")
+    ap.add_argument("--num-envs", type=positive_int, default=8,
+                    help="vector env size per configuration")
+    ap.add_argument("--seed", type=seed_int, default=0)
     ap.add_argument("--no-memory", action="store_true", help="skip the memory check")
     args = ap.parse_args(argv)
 

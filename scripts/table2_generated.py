@@ -19,7 +19,7 @@ import numpy as np
 
 from aerostat_gym.analysis.reference import TABLE2, table2
 from aerostat_gym.analysis.trim import TrimError
-from aerostat_gym.cli.common import run_script, script_description
+from aerostat_gym.cli.common import positive_int, run_script, script_description, seed_int
 from aerostat_gym.params import ParameterError, load_params
 from aerostat_gym.scaling import scale_aerostat
 
@@ -33,8 +33,8 @@ def draw(rng: np.random.Generator) -> tuple[float, float, int, float]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=script_description(__doc__))
-    ap.add_argument("--seeds", type=int, nargs="+", default=[0])
-    ap.add_argument("--count", type=int, default=200, help="aerostats per seed")
+    ap.add_argument("--seeds", type=seed_int, nargs="+", default=[0])
+    ap.add_argument("--count", type=positive_int, default=200, help="aerostats per seed")
     args = ap.parse_args(argv)
     base = load_params()
     diffs = {key: [] for key in TABLE2}

@@ -784,6 +784,7 @@ def test_memory_returns_after_closing_vector_envs():
     ("reproduce_figure8.py", ["--config", "TYPO", "--out", "OUT"], "unknown section(s): x"),
     ("task_returns.py", ["--policy", "nosuch"], "unknown policy 'nosuch'"),
     ("protocol_readme.py", ["missing.json"], "No such file or directory: 'missing.json'"),
+    ("protocol_readme.py", ["EMPTY"], "not a protocol.json written by aerostat-gym evaluate"),
 ])
 def test_9_scripts_refuse_bad_input_in_one_line(tmp_path, script, argv, text):
     """The scripts run their main as the CLI runs a command (aerostat_gym.cli.common.run_script):
@@ -793,8 +794,9 @@ def test_9_scripts_refuse_bad_input_in_one_line(tmp_path, script, argv, text):
     from pathlib import Path
 
     (tmp_path / "typo.toml").write_text("x = 1\n")
-    argv = [str(tmp_path / "typo.toml") if a == "TYPO" else str(tmp_path / "f8") if a == "OUT"
-            else a for a in argv]
+    (tmp_path / "empty.json").write_text("{}\n")
+    named = {"TYPO": tmp_path / "typo.toml", "OUT": tmp_path / "f8", "EMPTY": tmp_path / "empty.json"}
+    argv = [str(named[a]) if a in named else a for a in argv]
     path = Path(__file__).resolve().parent.parent / "scripts" / script
     done = subprocess.run([sys.executable, str(path), *argv], capture_output=True, text=True,
                           cwd=tmp_path, timeout=300)
