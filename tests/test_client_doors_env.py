@@ -457,3 +457,18 @@ def test_the_sb3_adapter_names_a_bad_seed_and_an_unknown_attribute():
         venv.get_attr("bogus")
     assert venv.get_attr("num_envs") == [2, 2]
     venv.close()
+
+
+def test_a_refused_snapshot_leaves_the_env_as_it_was():
+    """A snapshot whose np_random is not the env's generator state is refused before the
+    simulator slot is touched (the slot used to be overwritten, then numpy raised)."""
+    env = TetheredAerostatEnv()
+    env.reset(seed=0)
+    saved = env.get_state()
+    env.step(np.array([0.5], np.float32))
+    state = env.state
+    with pytest.raises(ValueError, match="set_state: np_random is not a PCG64 state"):
+        env.set_state({**saved, "np_random": {"bit_generator": "X"}})
+    np.testing.assert_array_equal(env.state, state)
+    env.set_state(saved)
+    np.testing.assert_array_equal(env.state, saved["state"])

@@ -384,6 +384,12 @@ class TetheredAerostatEnv(gym.Env):
         """Restore a :meth:`get_state` snapshot; returns the observation saved with it."""
         if not isinstance(saved, dict) or "np_random" not in saved:
             raise ValueError("set_state expects a dict from get_state()")
+        generator = type(self.np_random.bit_generator)()
+        try:  # checked on a spare generator first: a refused snapshot leaves the env as it was
+            generator.state = saved["np_random"]
+        except (TypeError, ValueError, KeyError) as exc:
+            raise ValueError(f"set_state: np_random is not a {type(generator).__name__} state "
+                             f"from get_state() ({exc})") from None
         self._batch.set_slot(0, saved)
         self.np_random.bit_generator.state = saved["np_random"]
         self._ready = True
