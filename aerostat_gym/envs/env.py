@@ -284,6 +284,15 @@ class TetheredAerostatEnv(gym.Env):
       net lift only just exceeds its tether's weight trims in light wind (failed after 6-24 s
       at 0.5-3 m/s), and a trim that would hang the tether below the ground is refused naming
       the weights; an off-grid reset speed's trim is remembered by the environment.
+    - v0 (aerostat-gym 0.7.15; dynamics, observation, reward, the registered tasks and their
+      seeded episodes unchanged): more is refused at make, each naming the value: a ``params``
+      rebuilt with ``dataclasses.replace`` meets the loader's field and cross checks; a log
+      wind profile with its roughness at or above its reference height; values no aerostat
+      has (``params.PLAUSIBLE_RANGES``: g, air density, tether damping, hull and fin drag, fin
+      lift slope); randomisation ranges whose ends are implausible; ``num_envs`` above 65,536;
+      ``control_step`` below 1 ms; a ``reward_fn`` that does not take (obs, action, info), or
+      returns a string or a bool. A 0-d array or NumPy scalar is a number. ``set_state``
+      leaves the env unchanged when it refuses a snapshot.
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}

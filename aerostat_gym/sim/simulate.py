@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..params import Params
-from ..physics.integrators import NONFINITE, advance_interval
+from ..physics.integrators import NONFINITE
 from ..physics.state import N_INPUTS, S_Z
 from ..wind.field import check_covers
 from . import events as E
@@ -128,12 +128,12 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
         check_covers(model.wp, model.wf, n_out * output_dt)
     winch = WinchController(model.params, output_dt)  # the stand-still clock ticks per interval
     times, states, tens, ends = [0.0], [x.copy()], [model.tensions(x)], [model.end_tensions(x)]
-    scheme, ground = model.scheme(integrator, dt), E.ground_height(model.params)
+    ground = E.ground_height(model.params)
     status, events, cmds = "ok", [], []
     for k in range(n_out):
         t = k * output_dt
         cmd = winch.command(_input(u, t, x), x, winch.load_cell(ends[-1][1]))
-        code, stats = _interval(model, x, t, output_dt, cmd.as_input(), scheme, ground)
+        code, stats = _interval(model, x, t, output_dt, cmd.as_input(), integrator, dt, ground)
         if code in _FAILED:
             status = STATUS[code]
             events.append(_failure_event(code, t + output_dt))
@@ -181,19 +181,18 @@ def _check_length(model: Model, x: np.ndarray) -> None:
 
 
 def _interval(model: Model, x: np.ndarray, t: float, interval: float, u: np.ndarray,
-              scheme: np.ndarray, ground: float) -> tuple[int, np.ndarray]:
+              integrator: str, dt: float | None, ground: float) -> tuple[int, np.ndarray]:
     """Advance x over one output interval and decide its outcome as an environment's control
     step does: (outcome code of :mod:`aerostat_gym.sim.events`, tension stats). x holds the
     state the run goes on from (re-integrated where a terminating step was re-run)."""
     x_prev = x.copy()
-    stats = np.array([0.0, np.inf])
-    if advance_interval(x, t, interval, u, model.p, model.wp, model.wf, model.work, scheme,
-                        stats) == NONFINITE:
+    status, stats = model.advance(x, t, interval, u, integrator, dt)
+    if status == NONFINITE:
         return E.NONFINITE, stats
     code = E.step_outcome(x, t + interval, model.p, stats[0], ground, math.inf)
     if E.terminating(code):
         code = resolve(code, x, x_prev, t, interval, u, model.p, model.wp, model.wf,
-                       model.work, scheme, stats, ground, math.inf)
+                       model.work, model.scheme(integrator, dt), stats, ground, math.inf)
     return code, stats
 
 
