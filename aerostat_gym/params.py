@@ -664,9 +664,17 @@ def check_plausibility(p: Params) -> None:
     """Refuse values that load but no real aerostat has (:class:`ImplausibleParameterError`),
     naming the field, the value, the bound and the likely slip. Run by :func:`load_params` and
     when an environment is made (:data:`PLAUSIBLE_RANGES` on every load and replace too)."""
-    a, t, d = p.aerostat, p.tether, p.derived
+    _plausible_tether(p)
+    _plausible_hull(p)
+    _plausible_body_points(p)
+    _plausible_numerics(p)
+
+
+def _plausible_tether(p: Params) -> None:
+    """The tether's stiffness (its stretch under its own breaking strength and under the net
+    lift) and its effective density."""
+    t, d = p.tether, p.derived
     E = t.youngs_modulus
-    # tether: its stretch under its own breaking strength and under the net lift
     break_strain, lift_strain = _div(t.strength, d.EA), _div(d.net_lift, d.EA)
     if E > TETHER_MODULUS_MAX:
         raise ImplausibleParameterError(
@@ -695,7 +703,11 @@ def check_plausibility(p: Params) -> None:
             "not the mass per length)"
             + _slip(rho_t, {"g/cm^3 written as kg/m^3": 1e3, "kg/m (mass per length) written "
                             "as kg/m^3": 1.0 / d.tether_area}, lambda v: lo <= v <= hi))
-    # hull: length, diameter and volume must describe one body
+
+
+def _plausible_hull(p: Params) -> None:
+    """Length, diameter and volume must describe one body."""
+    a = p.aerostat
     cyl = math.pi / 4.0 * a.diameter * a.diameter * a.length  # inf, not OverflowError
     prismatic, fineness = _div(a.volume, cyl), _div(a.length, a.diameter)
     lo, hi = HULL_PRISMATIC_MAX
@@ -715,7 +727,12 @@ def check_plausibility(p: Params) -> None:
             f"{fineness:.3g} lies outside [{HULL_FINENESS_MIN:g}, {HULL_FINENESS_MAX:g}] (a "
             "sphere has 1, aerostats 2.2-4, the slimmest airships about 8)"
             + ("; looks like length and diameter swapped" if fineness < 1 else ""))
-    # body points: x-z symmetry, and inside the hull's length envelope
+
+
+def _plausible_body_points(p: Params) -> None:
+    """The CB, the nose, the fins and the confluence point: in the x-z symmetry plane, and
+    inside (or for fins and the confluence point, near) the hull's length envelope."""
+    a = p.aerostat
     L, D = a.length, a.diameter
     x_nose, y_nose, z_axis = a.nose_position
     tol = 1e-6 * L  # rounding of a point written in the symmetry plane
@@ -765,7 +782,10 @@ def check_plausibility(p: Params) -> None:
             f"below the CM (bound {LEASH_DEPTH_MAX:g} x aerostat.length = {LEASH_DEPTH_MAX * L:g}"
             " m; the [LN02] rule is 1.5 diameters below the axis)"
             + _slip(zl, {"cm written as m": 0.01}, lambda v: -v <= LEASH_DEPTH_MAX * L))
-    # aerodynamics and numerics
+
+
+def _plausible_numerics(p: Params) -> None:
+    """The cross-flow drag coefficient and the integration steps."""
     if p.hull.Cdc > HULL_CDC_MAX:
         raise ImplausibleParameterError(
             f"hull.Cdc = {p.hull.Cdc:g} exceeds {HULL_CDC_MAX:g}: no cross-section has a "
