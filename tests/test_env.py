@@ -15,6 +15,7 @@ from dataclasses import replace
 import gymnasium as gym
 import numpy as np
 import pytest
+from gymnasium.error import ResetNeeded
 
 import aerostat_gym  # noqa: F401  (registers the environment)
 from aerostat_gym.envs import (
@@ -273,6 +274,13 @@ def test_ground_strike_terminates():
     _, r, term, _, info = env.step(np.array([0.0], np.float32))
     assert term and info["termination"] == "ground_strike"
     assert info["reward_termination"] == -100.0
+    # the episode is over: stepping on is refused (it went on integrating the struck system,
+    # -100 a step) until a reset starts a new one
+    with pytest.raises(ResetNeeded, match=r"step\(\) after the episode ended \(ground_strike\): "
+                       r"call reset\(\)"):
+        env.step(np.array([0.0], np.float32))
+    env.reset(seed=1)
+    assert not env.step(np.array([0.0], np.float32))[2]
 
 
 def test_vector_env_matches_single_envs():

@@ -7,6 +7,7 @@ import math
 
 import gymnasium as gym
 import numpy as np
+from gymnasium.error import ResetNeeded
 
 from ..sim.events import FAILURES, FIELD_END, OUTCOMES, RUNNING
 from . import reward
@@ -292,13 +293,18 @@ class TetheredAerostatEnv(gym.Env):
       lift slope); randomisation ranges whose ends are implausible; ``num_envs`` above 65,536;
       ``control_step`` below 1 ms; a ``reward_fn`` that does not take (obs, action, info), or
       returns a string or a bool. A 0-d array or NumPy scalar is a number. ``set_state``
-      leaves the env unchanged when it refuses a snapshot.
+      leaves the env unchanged when it refuses a snapshot. ``step()`` after the episode ended
+      (terminated, or truncated by the end of the wind field) raises
+      ``gymnasium.error.ResetNeeded`` naming the reason (it went on integrating the broken
+      system, -100 a step).
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}
     #: an episode runs and the env is open, so step() may go on: set by reset() and
     #: set_state(), cleared by close() (a class default: also for instances made before it)
     _ready = False
+    #: the reason the last episode ended (terminated or truncated by the env), until a reset
+    _ended: str | None = None
 
     def __init__(self, render_mode: str | None = None, **kwargs):
         if render_mode is not None and render_mode not in RENDER_MODES:
@@ -319,7 +325,7 @@ class TetheredAerostatEnv(gym.Env):
         super().reset(seed=seed)
         info = self._batch.reset_one(0, self.np_random, options)
         self._batch.add_noise(0, self.np_random)
-        self._ready = True
+        self._ready, self._ended = True, None
         if self.render_mode == "human":
             self.render()
         return self._batch.obs[0].copy(), info
@@ -327,6 +333,9 @@ class TetheredAerostatEnv(gym.Env):
     def step(self, action):
         b = self._batch
         if not self._ready:  # one flag per step; the reason is worked out only when it fails
+            if self._ended is not None:  # a broken tether or a spent wind field goes no further
+                raise ResetNeeded(f"step() after the episode ended ({self._ended}): call "
+                                  "reset() to start a new one")
             b.check_started("step()")
         clipped = b.set_actions(action)
         b.step()
@@ -348,6 +357,7 @@ class TetheredAerostatEnv(gym.Env):
                 info["termination"] = reason
                 if code in FAILURES:
                     info["failure"] = reason
+            self._ready, self._ended = False, reason
         if self.render_mode == "human":
             self.render()
         obs = b.obs[0].copy()
@@ -401,7 +411,7 @@ class TetheredAerostatEnv(gym.Env):
                              f"from get_state() ({exc})") from None
         self._batch.set_slot(0, saved)
         self.np_random.bit_generator.state = saved["np_random"]
-        self._ready = True
+        self._ready, self._ended = True, None
         return self._batch.obs[0].copy()
 
     @property
