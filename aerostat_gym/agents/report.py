@@ -194,7 +194,7 @@ def plot_training_curve(history: list[dict], out: Path, title: str = "") -> Path
 
 def plot(results: list[dict], out: Path) -> list[Path]:
     """Time histories of every policy overlaid (recover scenario) and damping ratios side by side."""
-    plt = agg_pyplot("the report's plots (--no-plots skips them)")
+    plt = agg_pyplot("writing the report's plots (--no-plots skips them)")
 
     paths = []
     if "recover" not in results[0]["scenarios"]:

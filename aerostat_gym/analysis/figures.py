@@ -27,7 +27,7 @@ FIG8_VARIABLES = (("x", "m"), ("y", "m"), ("z", "m"), ("phi", "rad"), ("theta", 
 
 
 def _pyplot():
-    return agg_pyplot("the figures")
+    return agg_pyplot("writing the figures")
 
 
 # --- Figure 8 ------------------------------------------------------------------------------------

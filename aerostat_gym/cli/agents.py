@@ -112,7 +112,7 @@ def _check_suite_winds(suite: str, speeds, params) -> None:
 
 def _evaluate_command(args) -> int:
     if not args.no_plots:
-        require_plotting("evaluate's plots (--no-plots skips them)")
+        require_plotting("writing evaluate's plots (--no-plots skips them)")
     _check_policies(args.policy)
     params = params_from_args(args)
     _check_suite_winds(args.suite, args.speeds, params)
@@ -126,7 +126,7 @@ def _evaluate_command(args) -> int:
     else:
         for scenario in results[0]["scenarios"]:
             print(f"{scenario}:\n{comparison_table(results, scenario)}\n")
-        print(f"report (Markdown, plots, JSON): {md}")
+        print(f"report (Markdown, {'' if args.no_plots else 'plots, '}JSON): {md}")
         if (md.parent / "protocol.md").is_file():
             print(f"protocol (per-cell CIs, paired verdicts, aggregate IQM): "
                   f"{md.parent / 'protocol.md'}")
@@ -153,7 +153,7 @@ def add_demo_parser(sub) -> None:
 
 def _demo_command(args) -> int:
     t0 = time.perf_counter()
-    require_plotting("the demo's report plots")
+    require_plotting("writing the demo's report plots")
     _check_policies([args.policy])
     params = params_from_args(args)
     policies = ["passive", "lqr"]

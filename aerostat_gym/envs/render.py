@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..extras import install_hint
 from ..params import Params
 from ..physics.core import rotation_matrix
 
@@ -603,4 +604,5 @@ def _require_matplotlib() -> None:
         from gymnasium.error import DependencyNotInstalled
 
         raise DependencyNotInstalled(
-            "rendering needs matplotlib: pip install 'aerostat-gym[plot]'") from exc
+            f"rendering needs matplotlib, the optional 'plot' extra: {install_hint('plot')}"
+        ) from exc
