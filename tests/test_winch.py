@@ -349,3 +349,18 @@ def test_a_manoeuvre_past_the_winch_limits_is_refused_at_the_door(base):
         reel_manoeuvre(base, 10.0, 1e9)
     with pytest.raises(ValueError, match=r"hold must be a finite time >= 0 s, got -1"):
         reel_manoeuvre(base, 10.0, -50.0, hold=-1.0)
+
+
+def test_a_negative_distance_reels_in_first_and_back(base):
+    """distance -20 m: the length reaches the trim's 300 m - 20 m (the brake's overshoot, 15 cm,
+    as reeling out overshoots), holds it to 1 mm until the reel-in time, then returns to 300 m
+    to 1 mm (the schedule divided the signed distance by the speed: it reeled in for 10 s
+    only and reached 290 m; -150 m gave a negative duration)."""
+    res = reel_manoeuvre(base, 10.0, -20.0, hold=20.0, settle=60.0)
+    tr = res.trajectory
+    assert tr.status == "ok"
+    assert res.reel_in_time == pytest.approx(20.0 / base.winch.max_speed + 20.0)
+    assert tr.length.min() == pytest.approx(280.0, abs=0.2)
+    held = tr.length[np.searchsorted(tr.time, res.reel_in_time) - 1]
+    assert held == pytest.approx(280.0, abs=1e-3)
+    assert tr.length[-1] == pytest.approx(300.0, abs=1e-3)

@@ -41,12 +41,13 @@ def reel_manoeuvre(params: Params | None = None, wind_speed: float = 10.0, dista
                    speed: float | None = None, hold: float = 30.0, settle: float = 300.0,
                    integrator: str = "rk4", dt: float | None = None, output_dt: float = 0.1,
                    gain: float = 1.0) -> Manoeuvre:
-    """Reel out ``distance`` metres from the trim and back, in a steady wind.
+    """Reel out ``distance`` metres from the trim and back, in a steady wind (a negative
+    distance reels in first).
 
     From the trim at the configured tether length and ``wind_speed``, the length target is
-    L0 + distance until ``reel_in_time`` = distance / speed + hold, then L0; the set-point is
+    L0 + distance until ``reel_in_time`` = |distance| / speed + hold, then L0; the set-point is
     clip(gain (target - L), +-speed) (default speed: the winch's speed limit) and the brake
-    engages near each target. The run lasts reel_in_time + distance / speed + settle seconds.
+    engages near each target. The run lasts reel_in_time + |distance| / speed + settle seconds.
     """
     params = params or load_params()
     speed = params.winch.max_speed if speed is None else float(speed)
@@ -63,12 +64,13 @@ def reel_manoeuvre(params: Params | None = None, wind_speed: float = 10.0, dista
         raise ValueError(f"distance must keep the tether within the winch's limits "
                          f"[{w.min_length:g}, {w.max_length:g}] m from the trim's {L0:g} m: "
                          f"[{w.min_length - L0:g}, {w.max_length - L0:g}] m, got {distance!r}")
-    t_in = distance / speed + hold
+    travel = abs(distance) / speed  # each way, at the top speed
+    t_in = travel + hold
 
     def target(t):
         return L0 + distance if t < t_in else L0
 
-    duration = t_in + distance / speed + settle
+    duration = t_in + travel + settle
     tr = simulate(params, eq.x, duration, wind=wind_speed, integrator=integrator, dt=dt,
                   output_dt=output_dt, u=length_hold_law(target, speed, gain, iL))
     targets = np.array([target(t) for t in tr.time])
