@@ -42,10 +42,17 @@ def require(module: str, purpose: str, extra: str, hint: str = "") -> ModuleType
             f"install it with: {install_hint(extra)}{hint}") from None
 
 
+def require_plotting(purpose: str) -> ModuleType:
+    """``matplotlib`` (the ``plot`` extra), or :class:`MissingExtraError` naming it; the
+    commands call it before their work where ``purpose`` will write figures, so a missing
+    extra is one line, not a traceback after the work."""
+    return require("matplotlib", purpose, "plot")
+
+
 def agg_pyplot(purpose: str):
     """``matplotlib.pyplot`` on the file-writing Agg backend (figures are written, not shown),
     or :class:`MissingExtraError` naming the ``plot`` extra; ``purpose`` says what needs it."""
-    require("matplotlib", purpose, "plot").use("Agg")
+    require_plotting(purpose).use("Agg")
     import matplotlib.pyplot as plt
 
     return plt

@@ -810,6 +810,13 @@ def _plausible_numerics(p: Params) -> None:
             f"{SEMI_IMPLICIT_REFUSE_FACTOR:g} x loads with a warning)")
 
 
+def paid_out_weight(p: Params, length: float | None = None) -> float:
+    """Weight [N] of ``length`` metres of tether (default ``tether.length``: the derived
+    ``tether_weight``)."""
+    return p.derived.mass_per_length * (p.tether.length if length is None else length) \
+        * p.environment.g
+
+
 def plausibility_warnings(p: Params) -> list[str]:
     """Values that are unusual but possible (a ParameterWarning each at load)."""
     a, t, d = p.aerostat, p.tether, p.derived
@@ -839,10 +846,9 @@ def plausibility_warnings(p: Params) -> list[str]:
     if p.hull.Cdc > HULL_CDC_WARN:
         out.append(f"hull.Cdc = {p.hull.Cdc:g} is above a circular cylinder's 0.3-1.2 "
                    f"(warning above {HULL_CDC_WARN:g})")
-    line_weight = d.mass_per_length * p.environment.g  # [N/m]
-    full = line_weight * p.winch.max_length
+    full = paid_out_weight(p, p.winch.max_length)
     if d.net_lift <= full:
-        reach = d.net_lift / line_weight
+        reach = d.net_lift / paid_out_weight(p, 1.0)
         out.append(f"the net lift ({d.net_lift:.1f} N) does not exceed the weight of "
                    f"winch.max_length = {p.winch.max_length:g} m of tether ({full:.1f} N): paid "
                    f"out past {reach:.0f} m, the line rests on the wind's lift alone, and in "
@@ -1059,9 +1065,9 @@ def status_slips(text: str) -> list[str]:
         words = [w.strip("(),:;.") for w in comment.split()]
         if any(w in STATUSES for w in words):
             continue
-        for w in words:
-            near = [s for s in STATUSES if len(w) >= 4 and w.isupper()
-                    and (w.startswith(s) or difflib.SequenceMatcher(None, w, s).ratio() >= 0.75)]
+        for w in (w for w in words if len(w) >= 4 and w.isupper()):
+            near = [s for s in STATUSES
+                    if w.startswith(s) or difflib.SequenceMatcher(None, w, s).ratio() >= 0.75]
             if near:
                 out.append(f"line {number}: {w!r} is no status word (did you mean {near[0]!r}? "
                            f"one of {', '.join(STATUSES)}); "

@@ -30,7 +30,7 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from ..checks import is_finite_number
-from ..params import MAX_WIND_SPEED, Params, load_params
+from ..params import MAX_WIND_SPEED, Params, load_params, paid_out_weight
 from ..physics.core import rotation_matrix
 from ..physics.state import S_Z
 from ..sim import Model
@@ -259,12 +259,6 @@ LIFT_MARGIN_SHARE = 0.5
 _WEIGHT_STEP_MIN = 1.0 / 256
 
 
-def _paid_out_weight(params: Params, length: float | None) -> float:
-    """Weight [N] of the tether paid out (``length`` m, default ``tether.length``)."""
-    return params.derived.mass_per_length * (params.tether.length if length is None
-                                             else length) * params.environment.g
-
-
 def _continue_in_tether_weight(params: Params, wind_speed: float, max_step: float, tol: float,
                                length: float | None,
                                cause: TrimError | None) -> tuple[np.ndarray, float, int]:
@@ -273,7 +267,7 @@ def _continue_in_tether_weight(params: Params, wind_speed: float, max_step: floa
     at that wind speed, in adaptive steps. Raises TrimError naming the net-lift margin where
     this fails too (after ``cause``, the continuation in wind's failure, where there was one)."""
     d, rho = params.derived, params.tether.density
-    weight = _paid_out_weight(params, length)
+    weight = paid_out_weight(params, length)
     f = LIFT_MARGIN_SHARE * d.net_lift / weight
 
     def lighter(s: float) -> Params:  # s = 0: the light tether, s = 1: the real one
@@ -345,7 +339,7 @@ def find_equilibrium(params: Params | None = None, wind_speed: float = 0.0,
                          f"model's incompressible aerodynamics end near Mach 0.3), got "
                          f"{wind_speed!r}")
     model = Model(params, 0.0)
-    weight = _paid_out_weight(params, length)
+    weight = paid_out_weight(params, length)
     if guess is None and weight >= params.derived.net_lift:
         # No still-air equilibrium to continue from: the vertical line would leave the winch in
         # compression (net lift - weight <= 0). Only the wind's lift can carry it.
@@ -396,7 +390,7 @@ def _check_flying(model: Model, x: np.ndarray, summary: dict, wind_speed: float)
     depth = -float(model.node_positions(x)[:, 2].min())
     if depth > 0:
         p, length = model.params, float(x[model.layout.winch_length])
-        weight = _paid_out_weight(p, length)
+        weight = paid_out_weight(p, length)
         raise TrimError(
             f"the solution at U = {wind_speed:g} m/s hangs the tether {depth:.1f} m below the "
             f"ground: the net lift ({p.derived.net_lift:.1f} N) and the wind's lift cannot hold "

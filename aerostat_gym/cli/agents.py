@@ -20,6 +20,7 @@ from ..analysis.modes import SET_NAMES, analyse
 from ..analysis.trim import find_equilibrium
 from ..envs.batch import trim_table
 from ..envs.config import TaskConfig
+from ..extras import require_plotting
 from ..params import load_params
 from ..registration import TASKS
 from .common import (
@@ -29,7 +30,6 @@ from .common import (
     output_dir,
     params_from_args,
     positive_int,
-    require_plotting,
     seed_int,
 )
 

@@ -14,7 +14,6 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from ..extras import require
 from ..params import ParameterError, load_params, shipped_configs, tomllib
 
 
@@ -111,12 +110,6 @@ def output_file(path: str, option: str) -> Path:
     out = Path(path)
     output_dir(str(out.parent), f"{option} {path}: its folder")
     return out
-
-
-def require_plotting(purpose: str) -> None:
-    """The ``plot`` extra (matplotlib), checked before a command's work where ``purpose`` will
-    write figures: a missing extra is one line naming it, not a traceback after the work."""
-    require("matplotlib", purpose, "plot")
 
 
 def config_source(text: str) -> str:

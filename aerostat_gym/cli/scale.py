@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..agents.train import ALGOS, load_hyperparams
-from ..extras import require
+from ..extras import require, require_plotting
 from ..resources import shipped_path
 from ..scale.bench import format_throughput, throughput
 from ..scale.mc_report import summarize, write_outputs
@@ -31,7 +31,7 @@ from ..scale.montecarlo import (
 )
 from ..scale.ranges import RANGE_SOURCES, estimated_ranges
 from ..scale.tune import SCHEDULERS, SEARCHERS, SearchOptions, TrialSetup, load_space, run_search
-from .common import config_label, positive_float, positive_int, require_plotting, seed_int
+from .common import config_label, positive_float, positive_int, seed_int
 
 # the stability commands' parsing of --wind, --config and --set, shared rather than copied
 from .stability import parse_speeds

@@ -34,6 +34,7 @@ from ..analysis.sensitivity import (
     sensitivity_table,
 )
 from ..analysis.trim import TrimLimitError, find_equilibrium, limit_warnings
+from ..extras import require_plotting
 from ..params import MAX_WIND_SPEED
 from .common import (
     add_config,
@@ -41,7 +42,6 @@ from .common import (
     params_from_args,
     positive_float,
     positive_int,
-    require_plotting,
     warn,
 )
 

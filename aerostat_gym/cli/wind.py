@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from ..agents.intensity import air_inertia_force
-from ..extras import agg_pyplot
+from ..extras import agg_pyplot, require_plotting
 from ..params import MAX_WIND_SPEED
 from ..physics.wind import PROFILES, W_FIELD_DT, W_TAYLOR_U
 from ..wind.field import build_wind, field_heights, field_times, mean_vector
@@ -39,7 +39,6 @@ from .common import (
     params_from_args,
     positive_float,
     positive_int,
-    require_plotting,
     seed_int,
 )
 

@@ -21,15 +21,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..physics.core import FASTMATH, evaluate_tether
-from ..physics.integrators import (
-    NONFINITE,
-    SCHEME_RK4_SAFETY,
-    SCHEME_SEMI_IMPLICIT,
-    SCHEME_SI_DT,
-    SCHEME_SIZE,
-    SCHEME_STEP,
-    advance_interval,
-)
+from ..physics.integrators import NONFINITE, SCHEME_SIZE, advance_interval
 from ..physics.outputs import winch_tension
 from ..physics.packing import P_NEL, P_W_VMAX
 from ..physics.state import (
@@ -51,12 +43,9 @@ from . import reward as R
 from . import spaces as S
 
 # --- configuration vector shared by all environments of a batch -----------------------------
-# It starts with the integration scheme vector of advance_interval (SCHEME_* entries), so the
-# configuration itself is passed as the scheme.
-C_SEMI_IMPLICIT = SCHEME_SEMI_IMPLICIT
-C_STEP = SCHEME_STEP  # fixed integration step [s] (0: the scheme's own)
-C_RK4_SAFETY = SCHEME_RK4_SAFETY
-C_SI_DT = SCHEME_SI_DT
+# It starts with the integration scheme vector of advance_interval (its SCHEME_* entries), so
+# the configuration itself is passed as the scheme (to advance_interval and to
+# sim.resolve.resolve, which shrinks the scheme's steps for its re-runs).
 C_DT = SCHEME_SIZE  # control step [s]
 C_GROUND = C_DT + 1  # ground-strike height of the CM [m] (one hull diameter)
 C_BRAKE_SPEED = C_DT + 2  # stand-still band of the set-point [m/s]

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..extras import install_hint
+from ..extras import MissingExtraError, require_plotting
 from ..params import Params
 from ..physics.core import rotation_matrix
 
@@ -598,11 +598,10 @@ def _fit_size(img: np.ndarray, height: int, width: int) -> np.ndarray:
 
 
 def _require_matplotlib() -> None:
+    """The plot extra, as Gymnasium's DependencyNotInstalled (its environments' convention)."""
     try:
-        import matplotlib  # noqa: F401
-    except ImportError as exc:  # pragma: no cover - matplotlib is in the plot/test extras
+        require_plotting("rendering")
+    except MissingExtraError as exc:  # pragma: no cover - matplotlib is in the plot/test extras
         from gymnasium.error import DependencyNotInstalled
 
-        raise DependencyNotInstalled(
-            f"rendering needs matplotlib, the optional 'plot' extra: {install_hint('plot')}"
-        ) from exc
+        raise DependencyNotInstalled(str(exc)) from None
