@@ -69,10 +69,18 @@ def _ancestors(name: str) -> set[str]:
     return {".".join(parts[:k]) for k in range(1, len(parts))}
 
 
+def _is_type_checking(test: ast.expr) -> bool:
+    """``if TYPE_CHECKING:`` or ``if typing.TYPE_CHECKING:``: a block for annotations that never
+    runs."""
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
 def _imports(module: str, source: str | None = None) -> tuple[set[str], list[str]]:
     """(internal imports run at import time, descriptions of imports inside functions). Import
     time covers every statement outside a function: the module body and anything nested in a
-    ``try``, an ``if`` or a class body, not only the top-level statements."""
+    ``try``, an ``if`` or a class body, not only the top-level statements; an
+    ``if TYPE_CHECKING:`` body (annotations only) never runs."""
     tree = ast.parse(MODULES[module].read_text() if source is None else source)
     top, nested = set(), []
 
@@ -80,6 +88,9 @@ def _imports(module: str, source: str | None = None) -> tuple[set[str], list[str
         for child in ast.iter_child_nodes(node):
             if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
                 visit(child, function or getattr(child, "name", "lambda"))
+            elif isinstance(child, ast.If) and _is_type_checking(child.test):
+                for other in child.orelse:  # the body runs for type checkers only
+                    visit(ast.Module(body=[other], type_ignores=[]), function)
             elif isinstance(child, (ast.Import, ast.ImportFrom)):
                 if function is None:
                     top.update(_resolve(module, child))
@@ -139,15 +150,18 @@ def test_the_walker_sees_the_package():
 
 
 def test_the_walker_sees_imports_nested_at_import_time():
-    """An import in a try, an if or a class body runs at import time and is an edge; one in a
-    function or a lambda's default is not (a check of the check)."""
+    """An import in a try, an if (its else too) or a class body runs at import time and is an
+    edge; one in a function, a lambda's default or an ``if TYPE_CHECKING:`` body is not (a check
+    of the check)."""
     source = ("try:\n    from ..envs import env\nexcept ImportError:\n    pass\n"
               "if True:\n    from ..agents import lqr\n"
               "class C:\n    from ..sim import model\n"
-              "def f():\n    from ..cli import main\n")
+              "def f():\n    from ..cli import main\n"
+              "if TYPE_CHECKING:\n    from ..scale import tune\nelse:\n    from ..bench import soak\n")
     top, nested = _imports("aerostat_gym.physics.outputs", source)
     assert top == {"aerostat_gym.envs", "aerostat_gym.envs.env", "aerostat_gym.agents",
-                   "aerostat_gym.agents.lqr", "aerostat_gym.sim", "aerostat_gym.sim.model"}
+                   "aerostat_gym.agents.lqr", "aerostat_gym.sim", "aerostat_gym.sim.model",
+                   "aerostat_gym.bench", "aerostat_gym.bench.soak"}
     assert nested == ["aerostat_gym.physics.outputs:10 in f()"]
 
 

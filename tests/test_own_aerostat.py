@@ -78,8 +78,8 @@ from aerostat_gym.params import (
     parameter_table,
     params_from_dict,
     tether_drag_step,
-    tomllib,
 )
+from aerostat_gym.params.files import tomllib
 from aerostat_gym.registration import ENV_ID
 from aerostat_gym.scaling import scale_aerostat
 from aerostat_gym.sim import Model, simulate

@@ -14,7 +14,8 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from ..params import ParameterError, load_params, shipped_configs, tomllib
+from ..params import ParameterError, load_params, shipped_configs
+from ..params.files import tomllib
 
 
 class OneLineParser(argparse.ArgumentParser):
