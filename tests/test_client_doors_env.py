@@ -472,3 +472,25 @@ def test_a_refused_snapshot_leaves_the_env_as_it_was():
     np.testing.assert_array_equal(env.state, state)
     env.set_state(saved)
     np.testing.assert_array_equal(env.state, saved["state"])
+
+
+def test_a_snapshot_from_another_task_is_refused_naming_what_differs():
+    """get_state's snapshot carries its task: restored into an env of another tether length
+    (same element count, so the same state layout) it would run on with this env's ground
+    height, bounds and trims. It is refused, naming the argument, and the env is left as it
+    was; an env made with the same arguments takes it and goes on bit for bit."""
+    src = TetheredAerostatEnv(**SMALL)
+    src.reset(seed=3)
+    saved = src.get_state()
+    ref = src.step([0.2])[0]
+    other = TetheredAerostatEnv(**{**SMALL, "tether_length": 250.0})
+    other.reset(seed=3)
+    state = other.state
+    with pytest.raises(ValueError, match=r"another task \(tether_length differ\)"):
+        other.set_state(saved)
+    np.testing.assert_array_equal(other.state, state)
+    with pytest.raises(ValueError, match="lacks its task"):
+        other.set_state({k: v for k, v in saved.items() if k != "task"})
+    twin = TetheredAerostatEnv(**SMALL)
+    twin.set_state(saved)
+    assert np.array_equal(twin.step([0.2])[0], ref)

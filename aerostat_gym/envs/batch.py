@@ -5,6 +5,7 @@ compiled call. It owns time, the episode starts and the turbulence bank; the Gym
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 
@@ -91,6 +92,14 @@ def check_num_envs(num_envs) -> int:
     if not is_whole(num_envs) or num_envs > MAX_ENVS:
         raise ValueError(f"num_envs must be an integer in [1, {MAX_ENVS}], got {num_envs!r}")
     return int(num_envs)
+
+
+def _differs(a, b) -> bool:
+    """Whether two task arguments differ (arrays compared element by element)."""
+    try:
+        return bool(a != b)
+    except (TypeError, ValueError):  # arrays, or containers of them
+        return not np.array_equal(np.asarray(a, dtype=object), np.asarray(b, dtype=object))
 
 
 class EnvBatch:
@@ -267,6 +276,7 @@ class EnvBatch:
         """A copy of everything that determines slot i's future (see :meth:`set_slot`)."""
         out = {name: np.copy(getattr(self, name)[i]) for name in self.SLOT_ARRAYS}
         out["episode"] = self.episodes[i]
+        out["task"] = self.task  # the env-wide half of the future: bank, trims, step, bounds
         return out
 
     def set_slot(self, i: int, saved: dict) -> None:
@@ -276,6 +286,7 @@ class EnvBatch:
         missing = sorted(set(self.SLOT_ARRAYS) - set(saved))
         if missing:
             raise ValueError(f"simulator state lacks {missing}")
+        self._check_same_task(saved.get("task"))
         if np.shape(saved["state"]) != self.state[i].shape:
             raise ValueError(f"simulator state has shape {np.shape(saved['state'])}, this "
                              f"environment's is {self.state[i].shape}")
@@ -285,6 +296,23 @@ class EnvBatch:
         obs = self.obs[i].copy()
         self.observe(i)  # the work array: the step reads the winch tension of its start state
         self.obs[i] = obs
+
+    def _check_same_task(self, task) -> None:
+        """A slot's snapshot runs on only in a batch of the same task: the turbulence bank, the
+        control step, the integrator and the observation bounds are the batch's, not the
+        slot's, so another task's snapshot would go on along another future than the one
+        saved (another tether length: another ground height and length bounds)."""
+        if task is self.task:
+            return
+        if not isinstance(task, TaskConfig):
+            raise ValueError("simulator state lacks its task (a snapshot from get_state())")
+        differ = [f.name for f in dataclasses.fields(TaskConfig)
+                  if f.compare and _differs(getattr(task, f.name), getattr(self.task, f.name))]
+        if differ:
+            raise ValueError(
+                f"the snapshot comes from an environment of another task ({', '.join(differ)} "
+                "differ): restored here it would not go on as saved; restore it into an "
+                "environment made with the same arguments")
 
     def set_actions(self, actions) -> np.ndarray:
         """Validate and store actions (see :func:`coerce_actions`): NaN/inf is an ActionError,

@@ -297,6 +297,11 @@ class TetheredAerostatEnv(gym.Env):
       (terminated, or truncated by the end of the wind field) raises
       ``gymnasium.error.ResetNeeded`` naming the reason (it went on integrating the broken
       system, -100 a step).
+    - v0 (aerostat-gym 0.7.16; dynamics, observation, reward, the registered tasks and their
+      seeded episodes unchanged): a ``get_state`` snapshot carries its task, and ``set_state``
+      refuses one from an environment made with other arguments, naming them (a snapshot from
+      another tether length with the same element count used to run on with this env's ground
+      height, bounds and turbulence bank).
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}
@@ -393,8 +398,9 @@ class TetheredAerostatEnv(gym.Env):
     def get_state(self) -> dict:
         """Everything that determines the rest of the episode: the simulator slot (state,
         trim, packed parameters, wind, clock, winch brake and last action), the last
-        observation, and the random generator's state (observation noise). Pass it to
-        :meth:`set_state` to return here: the steps that follow are bit-identical."""
+        observation, the random generator's state (observation noise) and the task. Pass it to
+        :meth:`set_state` of this environment, or of one made with the same arguments, to
+        return here: the steps that follow are bit-identical."""
         saved = self._batch.get_slot(0)
         saved["np_random"] = self.np_random.bit_generator.state
         return saved
