@@ -111,21 +111,7 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
     clamps), the same logic the environment uses per control step.
     """
     model = model or Model(params, wind)
-    check_integrator(integrator)
-    lay = model.layout
-    x = check_finite("x0", np.array(x0, dtype=float))
-    if x.shape != (lay.size,):
-        raise SimulationError(f"x0 must have shape ({lay.size},) for n = {model.n}, got {x.shape}")
-    _check_length(model, x)
-    if not (math.isfinite(duration) and duration > 0):
-        raise SimulationError(f"duration must be finite and > 0, got {duration!r}")
-    if not (math.isfinite(output_dt) and output_dt > 0):
-        raise SimulationError(f"output_dt must be finite and > 0, got {output_dt!r}")
-    if dt is not None and not (math.isfinite(dt) and dt > 0):
-        raise SimulationError(f"dt must be finite and > 0, got {dt!r}")
-    n_out = max(1, int(round(duration / output_dt)))
-    if model.wf.shape[1] > 1:  # a turbulence field must cover the whole run (clear error if not)
-        check_covers(model.wp, model.wf, n_out * output_dt)
+    x, n_out = _checked_start(model, x0, duration, integrator, dt, output_dt)
     winch = WinchController(model.params, output_dt)  # the stand-still clock ticks per interval
     times, states, tens, ends = [0.0], [x.copy()], [model.tensions(x)], [model.end_tensions(x)]
     ground = E.ground_height(model.params)
@@ -152,13 +138,43 @@ def simulate(params: Params | None, x0: np.ndarray, duration: float, wind=None,
             if code != E.TETHER_BREAK:  # the winch's events already end with the break
                 events.append(_ending_event(code, t + output_dt, x, model))
             break
-    S = np.array(states)
-    nodes = np.array([model.node_positions(s) for s in S])
-    end_T = np.array(ends)
+    return _trajectory(model, winch, np.array(times), np.array(states), np.array(tens),
+                       np.array(ends), cmds, status, events)
+
+
+def _checked_start(model: Model, x0, duration: float, integrator: str, dt: float | None,
+                   output_dt: float) -> tuple[np.ndarray, int]:
+    """(a copy of x0, the number of output intervals), each argument checked at the door: a
+    SimulationError naming it, never a failure mid-run."""
+    check_integrator(integrator)
+    lay = model.layout
+    x = check_finite("x0", np.array(x0, dtype=float))
+    if x.shape != (lay.size,):
+        raise SimulationError(f"x0 must have shape ({lay.size},) for n = {model.n}, got {x.shape}")
+    _check_length(model, x)
+    if not (math.isfinite(duration) and duration > 0):
+        raise SimulationError(f"duration must be finite and > 0, got {duration!r}")
+    if not (math.isfinite(output_dt) and output_dt > 0):
+        raise SimulationError(f"output_dt must be finite and > 0, got {output_dt!r}")
+    if dt is not None and not (math.isfinite(dt) and dt > 0):
+        raise SimulationError(f"dt must be finite and > 0, got {dt!r}")
+    n_out = max(1, int(round(duration / output_dt)))
+    if model.wf.shape[1] > 1:  # a turbulence field must cover the whole run (clear error if not)
+        check_covers(model.wp, model.wf, n_out * output_dt)
+    return x, n_out
+
+
+def _trajectory(model: Model, winch: WinchController, times: np.ndarray, S: np.ndarray,
+                tensions: np.ndarray, end_T: np.ndarray, cmds: list, status: str,
+                events: list) -> Trajectory:
+    """The recorded samples (states S, element and end tensions per sample, one winch command
+    per interval) as a :class:`Trajectory`, with the quantities read from them."""
+    lay = model.layout
     L = S[:, lay.winch_length]
     return Trajectory(
-        time=np.array(times), states=S, cm_pos=S[:, lay.cm_pos], cm_vel=S[:, lay.cm_vel],
-        euler=S[:, lay.euler], rates=S[:, lay.rates], node_pos=nodes, tensions=np.array(tens),
+        time=times, states=S, cm_pos=S[:, lay.cm_pos], cm_vel=S[:, lay.cm_vel],
+        euler=S[:, lay.euler], rates=S[:, lay.rates],
+        node_pos=np.array([model.node_positions(s) for s in S]), tensions=tensions,
         top_tension=end_T[:, 0], winch_tension=end_T[:, 1], length=L,
         reel_speed=S[:, lay.winch_speed], status=status, events=events,
         load_cell=np.array([winch.load_cell(b) for b in end_T[:, 1]]),
