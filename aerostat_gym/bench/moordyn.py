@@ -398,7 +398,6 @@ def compare_with_moordyn(quick: bool = False) -> dict:
     p = load_params(overrides={"environment.rho_air": RHO_AIR})
     eq = find_equilibrium(p, WIND)
     top = np.array(eq.summary["confluence_point_m"], dtype=float)
-    L = p.tether.length
 
     # --- MoorDyn ------------------------------------------------------------------------------
     dt_rk2 = rk2_stable_dt(p)
@@ -412,50 +411,19 @@ def compare_with_moordyn(quick: bool = False) -> dict:
     ref_key = max(runs, key=lambda k: runs[k]["real_time_factor"])
     ref = runs[ref_key]
 
-    # current check: total x drag against 0.5 rho Cd d L U^2 sin^3(phi), phi the chord's angle
-    # to the flow (+X): |D_n| = 0.5 rho Cd d U^2 sin^2 phi per length, its x part sin phi of that
-    chord = top - np.asarray(p.tether.anchor_position, float)
-    phi = math.acos(min(1.0, abs(chord[0]) / float(np.linalg.norm(chord))))
-    sin2 = math.sin(phi) ** 2
-    expected_drag = 0.5 * p.environment.rho_air * p.tether.Cd_normal * p.tether.diameter * L * WIND**2 * sin2**1.5
-    drag_ratio = ref["drag_x_total_N"] / expected_drag
-    if not 0.8 < drag_ratio < 1.2:
-        raise RuntimeError(f"MoorDyn's current does not act as set: x drag {ref['drag_x_total_N']:.1f} N, "
-                           f"expected ~{expected_drag:.1f} N")
+    expected_drag, drag_ratio, phi = _current_check(p, top, ref["drag_x_total_N"])
 
-    # --- ours: tether alone, top fixed -----------------------------------------------------------
+    # --- ours: tether alone (top fixed), then the full aerostat + tether ------------------------
     x0 = _chord_state(tether, eq.x)
     ours, static = {}, {}
-    md_inner = ref["node_pos"][1:-1]
     for integ in ("rk4", "semi-implicit"):
         wall = _time_advance(tether, x0, duration, integ, repeats)
         dt = dt_rk4 if integ == "rk4" else p.simulation.semi_implicit_dt
         ours[integ] = {"dt_s": dt, "wall_s": wall, "real_time_factor": duration / wall}
-        tr = simulate(p, x0, duration, wind=WIND, integrator=integ, model=tether, output_dt=1.0)
-        if tr.status != "ok":
-            raise RuntimeError(f"our tether-only run ({integ}) ended with status {tr.status!r}")
-        diff = np.linalg.norm(tr.node_pos[-1][1:-1] - md_inner, axis=1)
-        last5 = tr.node_pos[tr.time > duration - 5.0 - 1e-9][:, tether.n // 2]
-        top_o, bot_o = float(tr.top_tension[-1]), float(tr.winch_tension[-1])
-        static[integ] = {
-            "max_node_diff_m": float(diff.max()),
-            "rms_node_diff_m": float(np.sqrt(np.mean(diff**2))),
-            "max_node_diff_pct_length": float(100.0 * diff.max() / L),
-            "rms_node_diff_pct_length": float(100.0 * np.sqrt(np.mean(diff**2)) / L),
-            "top_tension_N": {"ours": top_o, "moordyn": ref["top_tension_N"]},
-            "bottom_tension_N": {"ours": bot_o, "moordyn": ref["bottom_tension_N"]},
-            "top_tension_rel_diff": top_o / ref["top_tension_N"] - 1.0,
-            "bottom_tension_rel_diff": bot_o / ref["bottom_tension_N"] - 1.0,
-            "moordyn_anchor_tension_native_N": ref["anchor_tension_native_N"],
-            "settle_drift_m": float(np.ptp(last5, axis=0).max()),
-            "position_target_met": bool(diff.max() / L < 0.005),
-        }
-
-    # --- ours: full aerostat + tether ----------------------------------------------------------
+        static[integ] = _static_against(tether, x0, duration, integ, ref)
     full = Model(p, wind=WIND)
-    full_rtf = {}
-    for integ in ("rk4", "semi-implicit"):
-        full_rtf[integ] = duration / _time_advance(full, eq.x, duration, integ, repeats)
+    full_rtf = {integ: duration / _time_advance(full, eq.x, duration, integ, repeats)
+                for integ in ("rk4", "semi-implicit")}
 
     ratio = {k: v / ref["real_time_factor"] for k, v in full_rtf.items()}
     ratio_rk2 = {k: v / runs["rk2"]["real_time_factor"] for k, v in full_rtf.items()}
@@ -480,19 +448,69 @@ def compare_with_moordyn(quick: bool = False) -> dict:
                            **{k: v["settle_drift_m"] for k, v in static.items()}},
         "current_check": {"moordyn_drag_x_N": ref["drag_x_total_N"],
                           "crossflow_estimate_N": expected_drag, "ratio": drag_ratio},
-        "moordyn_settings": (
-            f"MoorDyn {_version()}: 1 line, {p.tether.n_elements} segments, "
-            f"L = {L} m, d = {p.tether.diameter} m, m = {p.derived.mass_per_length:.6g} kg/m, "
-            f"EA = {p.derived.EA:.6g} N, BA = b = {p.derived.damping_b:.6g} N s, EI = 0, "
-            f"Cd = {p.tether.Cd_normal}, CdAx = Cd f_t(0)/pi = {axial_cdt(p):.4g}, Ca = CaAx = 0, "
-            f"rho = {RHO_AIR}, g = {p.environment.g}, steady uniform current {WIND} m/s along +X "
-            f"(Currents = 1), fixed ends, line {SUBMERGENCE:.0f} m below the surface; "
-            f"RK2 (default scheme) at dt = {dt_rk2:.4g} s (rk4_safety x its linear stability bound; "
-            f"the default CFL 0.5 step, {default['dt_s']:.4g} s, "
-            f"{'diverges' if default['diverged_within_s'] else 'does not diverge'} within 1 s), "
-            f"RK4 at our dt = {dt_rk4:.4g} s; "
-            f"Step calls of {duration / max(1, math.ceil(duration / STEP_CHUNK - 1e-9)):.3g} s; "
-            f"shortest of {repeats} timed runs after a warm-up, both codes"
-        ),
+        "moordyn_settings": _settings(p, dt_rk2, dt_rk4, default, duration, repeats),
         "differences": differences(p, phi),
     }
+
+
+def _current_check(p: Params, top: np.ndarray, drag_x: float) -> tuple[float, float, float]:
+    """(expected x drag [N], MoorDyn's x drag over it, the chord's angle phi to the flow):
+    MoorDyn's total x drag against 0.5 rho Cd d L U^2 sin^3(phi), phi the chord's angle to the
+    flow (+X): |D_n| = 0.5 rho Cd d U^2 sin^2 phi per length, its x part sin phi of that. A
+    ratio outside (0.8, 1.2) means MoorDyn's current does not act as set (a RuntimeError)."""
+    chord = top - np.asarray(p.tether.anchor_position, float)
+    phi = math.acos(min(1.0, abs(chord[0]) / float(np.linalg.norm(chord))))
+    t = p.tether
+    expected = (0.5 * p.environment.rho_air * t.Cd_normal * t.diameter * t.length * WIND**2
+                * (math.sin(phi) ** 2) ** 1.5)
+    ratio = drag_x / expected
+    if not 0.8 < ratio < 1.2:
+        raise RuntimeError(f"MoorDyn's current does not act as set: x drag {drag_x:.1f} N, "
+                           f"expected ~{expected:.1f} N")
+    return expected, ratio, phi
+
+
+def _static_against(tether: Model, x0: np.ndarray, duration: float, integrator: str,
+                    ref: dict) -> dict:
+    """Our tether-only run's final shape and end tensions against MoorDyn's reference run."""
+    L = tether.params.tether.length
+    tr = simulate(tether.params, x0, duration, wind=WIND, integrator=integrator, model=tether,
+                  output_dt=1.0)
+    if tr.status != "ok":
+        raise RuntimeError(f"our tether-only run ({integrator}) ended with status {tr.status!r}")
+    diff = np.linalg.norm(tr.node_pos[-1][1:-1] - ref["node_pos"][1:-1], axis=1)
+    last5 = tr.node_pos[tr.time > duration - 5.0 - 1e-9][:, tether.n // 2]
+    top_o, bot_o = float(tr.top_tension[-1]), float(tr.winch_tension[-1])
+    return {
+        "max_node_diff_m": float(diff.max()),
+        "rms_node_diff_m": float(np.sqrt(np.mean(diff**2))),
+        "max_node_diff_pct_length": float(100.0 * diff.max() / L),
+        "rms_node_diff_pct_length": float(100.0 * np.sqrt(np.mean(diff**2)) / L),
+        "top_tension_N": {"ours": top_o, "moordyn": ref["top_tension_N"]},
+        "bottom_tension_N": {"ours": bot_o, "moordyn": ref["bottom_tension_N"]},
+        "top_tension_rel_diff": top_o / ref["top_tension_N"] - 1.0,
+        "bottom_tension_rel_diff": bot_o / ref["bottom_tension_N"] - 1.0,
+        "moordyn_anchor_tension_native_N": ref["anchor_tension_native_N"],
+        "settle_drift_m": float(np.ptp(last5, axis=0).max()),
+        "position_target_met": bool(diff.max() / L < 0.005),
+    }
+
+
+def _settings(p: Params, dt_rk2: float, dt_rk4: float, default: dict, duration: float,
+              repeats: int) -> str:
+    """The comparison's MoorDyn settings, in words (the report's ``moordyn_settings``)."""
+    return (
+        f"MoorDyn {_version()}: 1 line, {p.tether.n_elements} segments, "
+        f"L = {p.tether.length} m, d = {p.tether.diameter} m, "
+        f"m = {p.derived.mass_per_length:.6g} kg/m, "
+        f"EA = {p.derived.EA:.6g} N, BA = b = {p.derived.damping_b:.6g} N s, EI = 0, "
+        f"Cd = {p.tether.Cd_normal}, CdAx = Cd f_t(0)/pi = {axial_cdt(p):.4g}, Ca = CaAx = 0, "
+        f"rho = {RHO_AIR}, g = {p.environment.g}, steady uniform current {WIND} m/s along +X "
+        f"(Currents = 1), fixed ends, line {SUBMERGENCE:.0f} m below the surface; "
+        f"RK2 (default scheme) at dt = {dt_rk2:.4g} s (rk4_safety x its linear stability bound; "
+        f"the default CFL 0.5 step, {default['dt_s']:.4g} s, "
+        f"{'diverges' if default['diverged_within_s'] else 'does not diverge'} within 1 s), "
+        f"RK4 at our dt = {dt_rk4:.4g} s; "
+        f"Step calls of {duration / max(1, math.ceil(duration / STEP_CHUNK - 1e-9)):.3g} s; "
+        f"shortest of {repeats} timed runs after a warm-up, both codes"
+    )
