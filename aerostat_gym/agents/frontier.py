@@ -386,7 +386,6 @@ def plot_frontier(rows: list[dict], limits: list[dict], out, max_speed: float = 
         The figure (closed to pyplot; its ``axes`` are the panels).
     """
     plt = agg_pyplot("the frontier figure")
-
     speeds = sorted({float(r["wind_speed"]) for r in rows} | {float(b["wind_speed"])
                                                               for b in limits})
     learned = list(dict.fromkeys(r["policy"] for r in rows if r["kind"] == "learned"))
@@ -399,81 +398,105 @@ def plot_frontier(rows: list[dict], limits: list[dict], out, max_speed: float = 
 
     for ax, U in zip(axes, speeds, strict=True):
         here = [r for r in rows if float(r["wind_speed"]) == U]
-        ys = []
         bound = next((b for b in limits if float(b["wind_speed"]) == U), None)
-        if bound is not None and bound.get("authority"):
-            h = ax.axhline(bound["zeta"], color="tab:blue", ls=":", lw=1.5)
-            ax.axhspan(bound["zeta"], 1.5, color="tab:blue", alpha=0.08, lw=0)
-            keep("authority bound (winch saturates)", h)
-        modal = sorted((r for r in here if r["kind"] == "modal"),
-                       key=lambda r: r["designed_zeta"])
-        free = [r for r in modal if not saturates(r, max_speed)]
-        sat = [r for r in modal if saturates(r, max_speed)]
-        if free:
-            (h,) = ax.plot([r["peak_reel_speed_m_s"] for r in free],
-                           [r["zeta_drift"] for r in free], "-o", color="tab:blue", ms=5,
-                           zorder=3)
-            keep("modal controller", h)
-        if sat:
-            link = free[-1:] + sat
-            ax.plot([r["peak_reel_speed_m_s"] for r in link], [r["zeta_drift"] for r in link],
-                    ":", color="tab:blue", lw=1, zorder=2)
-            (h,) = ax.plot([r["peak_reel_speed_m_s"] for r in sat],
-                           [r["zeta_drift"] for r in sat], "o", mfc="white", mec="tab:blue",
-                           ms=5, zorder=3)
-            keep("modal, winch saturated (not linear)", h)
-        ys += [r["zeta_drift"] for r in modal]
-        if bound is not None:
-            (h,) = ax.plot([bound["peak_set_point_m_s"]], [bound["zeta"]], "P", ms=10,
-                           color="tab:blue", mec="white", mew=0.8, zorder=4)
-            # below the limit: the design range's end (zeta 0.99) asks for less than the limit
-            short = bound["peak_set_point_m_s"] < 0.99 * max_speed
-            ax.annotate(f"ζ {'≥ ' if short else ''}{bound['zeta']:.2f}",
-                        (bound["peak_set_point_m_s"], bound["zeta"]),
-                        xytext=(-6, 6), textcoords="offset points", ha="right", fontsize=8,
-                        color="tab:blue")
-            ys.append(bound["zeta"])
-            keep("modal limit (linear)", h)
-        for r in here:
-            if r["kind"] in ("passive", "baseline"):
-                m, c, label = BASELINE_MARKERS.get(r["policy"], ("o", "grey", r["policy"]))
-                (h,) = ax.plot([r["peak_reel_speed_m_s"]], [r["zeta_drift"]], m, color=c, ms=7,
-                               mec="white", mew=0.6, zorder=5)
-                keep(label, h)
-            elif r["kind"] == "learned":
-                c = LEARNED_COLOURS[learned.index(r["policy"]) % len(LEARNED_COLOURS)]
-                (h,) = ax.plot([r["peak_reel_speed_m_s"]], [r["zeta_drift"]], "*", color=c,
-                               ms=14, mec="black", mew=0.6, zorder=6)
-                keep(f"{LEARNED_LABELS.get(r['policy'], r['policy'])} (learned)", h)
-            else:
-                continue
-            ys.append(r["zeta_drift"])
-        h = ax.axvline(max_speed, color="grey", ls="--", lw=1)
-        keep(f"winch limit {max_speed:g} m/s", h)
-        ys = [y for y in ys if y is not None and math.isfinite(y)]
-        if ys:
-            lo, hi = min(ys), max(ys)
-            pad = max(hi - lo, 0.05)
-            ax.set_ylim(lo - 0.06 * pad, hi + 0.12 * pad)
-        ax.set_xlim(-0.03, 1.05 * max_speed)
-        ax.set_title(f"U = {U:g} m/s", fontsize=10)
-        ax.set_xlabel("peak reel speed [m/s]")
-        ax.grid(alpha=0.3)
-        ax.tick_params(labelsize=8)
+        ys = _draw_modal(ax, here, bound, max_speed, keep)
+        ys += _draw_policies(ax, here, learned, keep)
+        keep(f"winch limit {max_speed:g} m/s", ax.axvline(max_speed, color="grey", ls="--", lw=1))
+        _frame_panel(ax, U, ys, max_speed)
     axes[0].set_ylabel("pendulum ζ, sinusoid + drift fit\n(within 5 % of the linear "
                        "eigenvalues)", fontsize=9)
+    rows_of_legend = _legend(fig, handles)
+    title = "Pendulum damping against peak reel speed"
+    if swing is not None:
+        title += f" ({swing:g} m along-wind swing, steady wind, shipped winch)"
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout(rect=(0, 0.13 if rows_of_legend > 1 else 0.07, 1, 1))
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return fig
+
+
+def _draw_modal(ax, here: list[dict], bound: dict | None, max_speed: float, keep) -> list:
+    """One panel's modal controller: its curve (hollow where the winch saturates), its linear
+    end at the speed limit and, where the winch saturates, the authority bound. Returns the
+    damping ratios drawn."""
+    ys = []
+    if bound is not None and bound.get("authority"):
+        h = ax.axhline(bound["zeta"], color="tab:blue", ls=":", lw=1.5)
+        ax.axhspan(bound["zeta"], 1.5, color="tab:blue", alpha=0.08, lw=0)
+        keep("authority bound (winch saturates)", h)
+    modal = sorted((r for r in here if r["kind"] == "modal"), key=lambda r: r["designed_zeta"])
+    free = [r for r in modal if not saturates(r, max_speed)]
+    sat = [r for r in modal if saturates(r, max_speed)]
+    if free:
+        (h,) = ax.plot([r["peak_reel_speed_m_s"] for r in free], [r["zeta_drift"] for r in free],
+                       "-o", color="tab:blue", ms=5, zorder=3)
+        keep("modal controller", h)
+    if sat:
+        link = free[-1:] + sat
+        ax.plot([r["peak_reel_speed_m_s"] for r in link], [r["zeta_drift"] for r in link],
+                ":", color="tab:blue", lw=1, zorder=2)
+        (h,) = ax.plot([r["peak_reel_speed_m_s"] for r in sat], [r["zeta_drift"] for r in sat],
+                       "o", mfc="white", mec="tab:blue", ms=5, zorder=3)
+        keep("modal, winch saturated (not linear)", h)
+    ys += [r["zeta_drift"] for r in modal]
+    if bound is not None:
+        (h,) = ax.plot([bound["peak_set_point_m_s"]], [bound["zeta"]], "P", ms=10,
+                       color="tab:blue", mec="white", mew=0.8, zorder=4)
+        # below the limit: the design range's end (zeta 0.99) asks for less than the limit
+        short = bound["peak_set_point_m_s"] < 0.99 * max_speed
+        ax.annotate(f"ζ {'≥ ' if short else ''}{bound['zeta']:.2f}",
+                    (bound["peak_set_point_m_s"], bound["zeta"]),
+                    xytext=(-6, 6), textcoords="offset points", ha="right", fontsize=8,
+                    color="tab:blue")
+        ys.append(bound["zeta"])
+        keep("modal limit (linear)", h)
+    return ys
+
+
+def _draw_policies(ax, here: list[dict], learned: list[str], keep) -> list:
+    """One panel's passive winch, baselines and learned policies, a marker each. Returns the
+    damping ratios drawn."""
+    ys = []
+    for r in here:
+        if r["kind"] in ("passive", "baseline"):
+            m, c, label = BASELINE_MARKERS.get(r["policy"], ("o", "grey", r["policy"]))
+            (h,) = ax.plot([r["peak_reel_speed_m_s"]], [r["zeta_drift"]], m, color=c, ms=7,
+                           mec="white", mew=0.6, zorder=5)
+            keep(label, h)
+        elif r["kind"] == "learned":
+            c = LEARNED_COLOURS[learned.index(r["policy"]) % len(LEARNED_COLOURS)]
+            (h,) = ax.plot([r["peak_reel_speed_m_s"]], [r["zeta_drift"]], "*", color=c,
+                           ms=14, mec="black", mew=0.6, zorder=6)
+            keep(f"{LEARNED_LABELS.get(r['policy'], r['policy'])} (learned)", h)
+        else:
+            continue
+        ys.append(r["zeta_drift"])
+    return ys
+
+
+def _frame_panel(ax, U: float, ys: list, max_speed: float) -> None:
+    """Limits (the y range of what is drawn), title and labels of one panel."""
+    ys = [y for y in ys if y is not None and math.isfinite(y)]
+    if ys:
+        lo, hi = min(ys), max(ys)
+        pad = max(hi - lo, 0.05)
+        ax.set_ylim(lo - 0.06 * pad, hi + 0.12 * pad)
+    ax.set_xlim(-0.03, 1.05 * max_speed)
+    ax.set_title(f"U = {U:g} m/s", fontsize=10)
+    ax.set_xlabel("peak reel speed [m/s]")
+    ax.grid(alpha=0.3)
+    ax.tick_params(labelsize=8)
+
+
+def _legend(fig, handles: dict) -> int:
+    """The figure's legend below the panels, baselines first; returns its number of rows."""
     order = [label for _, _, label in BASELINE_MARKERS.values()]
     order += [k for k in handles if k.endswith("(learned)")]
     order += ["modal controller", "modal, winch saturated (not linear)", "modal limit (linear)",
               "authority bound (winch saturates)"]
     labels = [k for k in order if k in handles] + [k for k in handles if k not in order]
-    fig.legend([handles[k] for k in labels], labels, loc="lower center",
-               ncol=min(len(labels), 5), fontsize=8, frameon=False)
-    title = "Pendulum damping against peak reel speed"
-    if swing is not None:
-        title += f" ({swing:g} m along-wind swing, steady wind, shipped winch)"
-    fig.suptitle(title, fontsize=10)
-    fig.tight_layout(rect=(0, 0.13 if len(labels) > 5 else 0.07, 1, 1))
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return fig
+    ncol = min(len(labels), 5)
+    fig.legend([handles[k] for k in labels], labels, loc="lower center", ncol=ncol, fontsize=8,
+               frameon=False)
+    return math.ceil(len(labels) / ncol) if labels else 0
