@@ -5,7 +5,6 @@ compiled call. It owns time, the episode starts and the turbulence bank; the Gym
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import warnings
 
@@ -94,14 +93,6 @@ def check_num_envs(num_envs) -> int:
     return int(num_envs)
 
 
-def _differs(a, b) -> bool:
-    """Whether two task arguments differ (arrays compared element by element)."""
-    try:
-        return bool(a != b)
-    except (TypeError, ValueError):  # arrays, or containers of them
-        return not np.array_equal(np.asarray(a, dtype=object), np.asarray(b, dtype=object))
-
-
 class EnvBatch:
     """N environments of one task in flat arrays (see the module docstring).
 
@@ -161,11 +152,14 @@ class EnvBatch:
 
     def _bank(self) -> np.ndarray:
         turb = self.task.resolved["turbulence"]
+        self._bank_key = None  # what the bank is made from (see world())
         if turb.is_off:
             return NO_BANK
         u_max = self.trims.speeds[-1] * _advection_factor(self.params, turb)
         need = field_length_needed(turb, u_max)
         # unit-variance fields, scaled per episode to its mean wind (episodes._intensity)
+        self._bank_key = (repr(turb.unit()), self.task.wind_bank_size, self.task.wind_bank_seed,
+                          need)
         return unit_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
 
     def release(self) -> None:
@@ -206,6 +200,7 @@ class EnvBatch:
     def __setstate__(self, d):
         self.__dict__.update(d)
         self.__dict__.setdefault("closed", False)  # pickled before the flag existed
+        self.__dict__.setdefault("_bank_key", None)  # set by _bank() on an open batch
         self.trims = TrimTable(self.params, *self.task.resolved["wind_speed"])
         # found in the cache while another holder lives; a closed batch stays closed
         self.bank = NO_BANK if self.closed else self._bank()
@@ -276,7 +271,7 @@ class EnvBatch:
         """A copy of everything that determines slot i's future (see :meth:`set_slot`)."""
         out = {name: np.copy(getattr(self, name)[i]) for name in self.SLOT_ARRAYS}
         out["episode"] = self.episodes[i]
-        out["task"] = self.task  # the env-wide half of the future: bank, trims, step, bounds
+        out["world"] = self.world()  # the batch-wide half of the slot's future
         return out
 
     def set_slot(self, i: int, saved: dict) -> None:
@@ -286,10 +281,10 @@ class EnvBatch:
         missing = sorted(set(self.SLOT_ARRAYS) - set(saved))
         if missing:
             raise ValueError(f"simulator state lacks {missing}")
-        self._check_same_task(saved.get("task"))
         if np.shape(saved["state"]) != self.state[i].shape:
             raise ValueError(f"simulator state has shape {np.shape(saved['state'])}, this "
                              f"environment's is {self.state[i].shape}")
+        self._check_same_world(saved.get("world"))
         for name in self.SLOT_ARRAYS:
             getattr(self, name)[i] = saved[name]
         self.episodes[i] = saved["episode"]
@@ -297,21 +292,40 @@ class EnvBatch:
         self.observe(i)  # the work array: the step reads the winch tension of its start state
         self.obs[i] = obs
 
-    def _check_same_task(self, task) -> None:
-        """A slot's snapshot runs on only in a batch of the same task: the turbulence bank, the
-        control step, the integrator and the observation bounds are the batch's, not the
-        slot's, so another task's snapshot would go on along another future than the one
-        saved (another tether length: another ground height and length bounds)."""
-        if task is self.task:
+    def world(self) -> dict:
+        """What the batch, not the slot, contributes to a slot's future, by name: the
+        turbulence fields the slot reads, the control step, the ground, winch and reward
+        settings of the configuration vector, the observation's layout, bounds and noise.
+        Equal arguments resolve to an equal world (``params=None`` and the baseline loaded,
+        ``(8, 8)`` and ``8``); the integration scheme is not part of it (a snapshot may be
+        re-run on a finer step) and neither is a ``reward_fn``."""
+        c = self.cfg
+        return {
+            "turbulence fields": self._bank_key,
+            "control_step": float(c[K.C_DT]),
+            "ground height (hull diameter)": float(c[K.C_GROUND]),
+            "winch brake and limits": c[[K.C_BRAKE_SPEED, K.C_HOLD_SPEED, K.C_BRAKE_DWELL,
+                                         K.C_SWL, K.C_FMAX]].tolist(),
+            "reward weights and length band": c[K.C_LENGTH_BAND:].tolist(),
+            "observation bounds": (self.obs_low.tolist(), self.obs_high.tolist()),
+            "obs_noise": float(self.task.obs_noise),
+        }
+
+    def _check_same_world(self, world: dict | None) -> None:
+        """A snapshot runs on as saved only in a batch of the same world (:meth:`world`):
+        another one (another hull, winch, control step or turbulence) is refused, naming what
+        differs. A snapshot without its world (taken before aerostat-gym 0.7.16) is taken on
+        trust."""
+        if world is None:
             return
-        if not isinstance(task, TaskConfig):
-            raise ValueError("simulator state lacks its task (a snapshot from get_state())")
-        differ = [f.name for f in dataclasses.fields(TaskConfig)
-                  if f.compare and _differs(getattr(task, f.name), getattr(self.task, f.name))]
+        if not isinstance(world, dict):
+            raise ValueError("simulator state's world is not a dict from get_state()")
+        mine = self.world()
+        differ = [k for k in mine if world.get(k) != mine[k]]
         if differ:
             raise ValueError(
-                f"the snapshot comes from an environment of another task ({', '.join(differ)} "
-                "differ): restored here it would not go on as saved; restore it into an "
+                f"the snapshot comes from an environment whose {', '.join(differ)} differ from "
+                "this one's: restored here it would not go on as saved; restore it into an "
                 "environment made with the same arguments")
 
     def set_actions(self, actions) -> np.ndarray:

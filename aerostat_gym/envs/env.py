@@ -298,10 +298,13 @@ class TetheredAerostatEnv(gym.Env):
       ``gymnasium.error.ResetNeeded`` naming the reason (it went on integrating the broken
       system, -100 a step).
     - v0 (aerostat-gym 0.7.16; dynamics, observation, reward, the registered tasks and their
-      seeded episodes unchanged): a ``get_state`` snapshot carries its task, and ``set_state``
-      refuses one from an environment made with other arguments, naming them (a snapshot from
-      another tether length with the same element count used to run on with this env's ground
-      height, bounds and turbulence bank).
+      seeded episodes unchanged): a ``get_state`` snapshot carries what the environment, not
+      the simulator slot, adds to its future (``world``: turbulence fields, control step,
+      ground, winch and reward settings, observation bounds and noise), and ``set_state``
+      refuses one whose world differs, naming what differs (a snapshot from another tether
+      length with the same element count ran on with this env's reward band). Arguments
+      that resolve alike are the same world; another integration step is allowed (a re-run
+      on a finer step); snapshots of 0.7.15 and before are taken on trust.
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}
@@ -398,15 +401,20 @@ class TetheredAerostatEnv(gym.Env):
     def get_state(self) -> dict:
         """Everything that determines the rest of the episode: the simulator slot (state,
         trim, packed parameters, wind, clock, winch brake and last action), the last
-        observation, the random generator's state (observation noise) and the task. Pass it to
-        :meth:`set_state` of this environment, or of one made with the same arguments, to
-        return here: the steps that follow are bit-identical."""
+        observation, the random generator's state (observation noise) and what the
+        environment adds to the slot's future (``world``: turbulence fields, control step,
+        ground, winch and reward settings, observation bounds). Pass it to :meth:`set_state` of
+        this environment, or of one made with the same arguments, to return here: the steps
+        that follow are bit-identical."""
         saved = self._batch.get_slot(0)
         saved["np_random"] = self.np_random.bit_generator.state
         return saved
 
     def set_state(self, saved: dict) -> np.ndarray:
-        """Restore a :meth:`get_state` snapshot; returns the observation saved with it."""
+        """Restore a :meth:`get_state` snapshot; returns the observation saved with it. A
+        snapshot of an environment with another world (see :meth:`get_state`) is refused,
+        naming what differs, and leaves this one as it was; one taken on another integration
+        step is accepted (a re-run of the same state on a finer step)."""
         if not isinstance(saved, dict) or "np_random" not in saved:
             raise ValueError("set_state expects a dict from get_state()")
         generator = type(self.np_random.bit_generator)()
