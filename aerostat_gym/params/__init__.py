@@ -23,7 +23,8 @@ One job per module, from the bottom up (each imports only those above it in this
 - ``files``: loading and writing parameter files; the status comments.
 - ``table``: the parameter table with the status of every value.
 
-Everything public is importable from ``aerostat_gym.params`` itself.
+Everything public is importable from ``aerostat_gym.params`` itself; the modules' other
+names (``check_value``, ``config_text``, ...) serve the package's own modules.
 """
 
 from .constraints import (

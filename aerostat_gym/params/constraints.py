@@ -18,7 +18,7 @@ from .schema import (
 
 #: Largest number of fin panels: the compiled core packs the panels into a fixed-size block
 #: (aerostat_gym.physics.packing.MAX_FINS is this constant; params sits below the physics
-#: layer, so the core imports it from here).
+#: layer, so the core imports it from aerostat_gym.params).
 MAX_FIN_PANELS = 6
 #: [m/s] the fastest mean wind the model is defined for (every door checks this one): the
 #: aerodynamics are incompressible (one air density everywhere), valid below Mach 0.3, about

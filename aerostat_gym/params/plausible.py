@@ -9,7 +9,9 @@ alike, and by the environment when it is made); values that are unusual but poss
 to 70 m hulls, tethers from 20 m to 5 km of Dyneema, Kevlar, Vectran, polyester or steel-armoured
 conductor cable all pass. They are not checked by Params.replace / apply_overrides, so that
 studies may still move one value past them on purpose (a weightless tether, RK4 past its
-stability bound) in the simulator.
+stability bound) in the simulator; the exception is :data:`PLAUSIBLE_RANGES`, single values
+no aerostat on any planet has, which every load, override and replace checks
+(:func:`aerostat_gym.params.constraints.check_constraints`).
 """
 
 from __future__ import annotations
