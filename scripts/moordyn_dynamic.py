@@ -1,5 +1,5 @@
 """Dynamic comparison of the tether with MoorDyn v2 (issue 20): a thin shim over
-:func:`aerostat_gym.bench_moordyn_dynamic.run_dynamic_comparison`.
+:func:`aerostat_gym.bench.moordyn_dynamic.run_dynamic_comparison`.
 
 Usage::
 

@@ -30,7 +30,11 @@ import numpy as np
 import pytest
 
 from aerostat_gym.bench import moordyn_dynamic as B
+from aerostat_gym.bench.moordyn import RHO_AIR
+from aerostat_gym.bench.moordyn_dynamic.driven import _place_top
 from aerostat_gym.cli import main
+from aerostat_gym.physics.integrators import OK
+from aerostat_gym.sim import BRAKED
 
 L = 300.0
 
@@ -81,7 +85,7 @@ def test_top_end_on_the_path(setup):
     x = setup.x_settled.copy()
     m = setup.model
     h = B.OUTPUT_DT / B.RK4_SUBSTEPS
-    assert B.driven_rk4(x, 0.0, h, 90, path, B.BRAKED, m.p, m.wp, m.wf, m.work, B.NO_SWAP) == B.OK
+    assert B.driven_rk4(x, 0.0, h, 90, path, BRAKED, m.p, m.wp, m.wf, m.work, B.NO_SWAP) == OK
     t = 90 * h
     expected = setup.top + np.array([0.0, 0.0, 5.0 * math.sin(2.0 * math.pi * t / 3.0)])
     np.testing.assert_allclose(m.node_positions(x)[0], expected, atol=1e-9)
@@ -96,7 +100,7 @@ def test_held_top_stays_settled(setup):
     path = B.DrivenCase("hold", B.SINE, period=1.0).pack(setup.top, setup.lever, L)
     m = setup.model
     x = setup.x_settled.copy()
-    B.driven_rk4(x, 0.0, 0.005, 1000, path, B.BRAKED, m.p, m.wp, m.wf, m.work, B.NO_SWAP)
+    B.driven_rk4(x, 0.0, 0.005, 1000, path, BRAKED, m.p, m.wp, m.wf, m.work, B.NO_SWAP)
     moved = np.abs(m.node_positions(x) - m.node_positions(setup.x_settled)).max()
     assert moved < 0.02
 
@@ -106,7 +110,7 @@ def _vertical_line(setup):
     m = setup.model
     top = np.array([0.0, 0.0, 300.3])
     x = setup.x_settled.copy()
-    B._place_top(x, m.layout.cm_pos.start, B.DrivenCase("v", B.SINE, period=1.0)
+    _place_top(x, m.layout.cm_pos.start, B.DrivenCase("v", B.SINE, period=1.0)
                  .pack(top, setup.lever, L), 0.0, 0.0)
     n = m.n
     for k in range(1, n):
@@ -118,7 +122,7 @@ def _vertical_line(setup):
 def test_node_drag_laws_closed_form(setup):
     x, w = _vertical_line(setup)
     m, swap = setup.model, setup.swap
-    q = 0.5 * B.RHO_AIR * 1.2 * 0.006 * 30.0 * 10.0**2  # 13.23 N on each inner node
+    q = 0.5 * RHO_AIR * 1.2 * 0.006 * 30.0 * 10.0**2  # 13.23 N on each inner node
     for j in (1, 5, 9):
         np.testing.assert_allclose(B.moordyn_node_drag(x, m.p, w, j, swap), [q, 0.0, 0.0],
                                    rtol=1e-9, atol=1e-9)
