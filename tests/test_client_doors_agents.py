@@ -11,9 +11,10 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
+from aerostat_gym.agents.hyperparams import TrainingError, check_hyperparams, load_hyperparams
 from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.agents.sb3io import PolicyError, SB3Policy, saved_algorithm
-from aerostat_gym.agents.train import TrainingError, check_hyperparams, load_hyperparams, train
+from aerostat_gym.agents.train import train
 from aerostat_gym.cli import main
 from aerostat_gym.envs.sb3 import sb3_vec_env
 from aerostat_gym.envs.spaces import (

@@ -18,7 +18,8 @@ import tomllib
 import yaml
 
 import aerostat_gym
-from aerostat_gym.agents.train import TrainingError, load_hyperparams, normalize_kwargs, train
+from aerostat_gym.agents.hyperparams import TrainingError, load_hyperparams, normalize_kwargs
+from aerostat_gym.agents.train import train
 from aerostat_gym.registration import TASKS
 from aerostat_gym.resources import SHIPPED_POLICY, shipped_path
 

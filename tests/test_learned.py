@@ -11,15 +11,10 @@ import pytest
 import yaml
 
 from aerostat_gym.agents.evaluate import run_scenario, suite_score
+from aerostat_gym.agents.hyperparams import TrainingError
 from aerostat_gym.agents.policies import load_policy
 from aerostat_gym.agents.sb3io import CommandShaper, PolicyError, SB3Policy, read_wrappers
-from aerostat_gym.agents.train import (
-    TrainingError,
-    make_training_env,
-    residual_base,
-    train,
-    wrapper_spec,
-)
+from aerostat_gym.agents.train import make_training_env, residual_base, train, wrapper_spec
 from aerostat_gym.envs.spaces import N_OBS
 
 TASK = "TetheredAerostat-v0"

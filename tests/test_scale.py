@@ -14,7 +14,7 @@ import pytest
 from scipy import stats
 
 from aerostat_gym.agents.evaluate import evaluate_policy
-from aerostat_gym.agents.train import load_hyperparams
+from aerostat_gym.agents.hyperparams import load_hyperparams
 from aerostat_gym.analysis.sensitivity import DAMPING_SPEEDS, default_knobs
 from aerostat_gym.analysis.sensitivity import stability_figures as sensitivity_evaluate
 from aerostat_gym.cli import main

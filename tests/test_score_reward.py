@@ -10,13 +10,14 @@ import numpy as np
 import pytest
 import yaml
 
+from aerostat_gym.agents.hyperparams import TrainingError
 from aerostat_gym.agents.sb3io import PolicyError
 from aerostat_gym.agents.score_reward import (
     DEFAULT_FLOOR,
     check_score_reward,
     score_reward_vec_env,
 )
-from aerostat_gym.agents.train import TrainingError, train
+from aerostat_gym.agents.train import train
 from aerostat_gym.envs import TetheredAerostatEnv
 from aerostat_gym.envs.config import TaskError
 from aerostat_gym.envs.reference import BrakedReference

@@ -10,9 +10,10 @@ import json
 
 import pytest
 
+from aerostat_gym.agents.hyperparams import load_hyperparams
 from aerostat_gym.agents.protocol_stats import bootstrap_mean_ci
 from aerostat_gym.agents.returns import RETURN_SEEDS, task_returns
-from aerostat_gym.agents.train import load_hyperparams, train
+from aerostat_gym.agents.train import train
 from aerostat_gym.resources import shipped_path
 
 

@@ -7,6 +7,7 @@ import sys
 import time
 
 from ..agents.evaluate import SUITES, cells_wind_range, suite_cells
+from ..agents.hyperparams import ALGOS
 from ..agents.policies import BASELINES, SHIPPED, load_policy
 from ..agents.report import (
     comparison_table,
@@ -15,7 +16,7 @@ from ..agents.report import (
     run_evaluations,
     write_report,
 )
-from ..agents.train import ALGOS, train
+from ..agents.train import train
 from ..analysis.modes import SET_NAMES, analyse
 from ..analysis.trim import find_equilibrium
 from ..envs.batch import trim_table

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..agents.train import ALGOS, load_hyperparams
+from ..agents.hyperparams import ALGOS, load_hyperparams
 from ..extras import require, require_plotting
 from ..resources import shipped_path
 from ..scale.bench import format_throughput, throughput

@@ -35,9 +35,10 @@ from pathlib import Path
 import numba
 import numpy as np
 
+from ..agents.hyperparams import PROJECT_BLOCK
 from ..agents.protocol_stats import bootstrap_mean_ci
 from ..agents.sb3io import vecnormalize_path
-from ..agents.train import PROJECT_BLOCK, train
+from ..agents.train import train
 from ..checks import is_whole
 from ..extras import require
 from .cluster import start_ray, stop_ray
