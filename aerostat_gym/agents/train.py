@@ -1,8 +1,8 @@
 """``aerostat-gym train``: Stable-Baselines3 training on the native batched environment.
 
 Hyperparameters come from rl-baselines3-zoo YAML that the zoo itself reads unchanged (read and
-checked by :mod:`aerostat_gym.agents.hyperparams`): a block per registered task id (keys ``n_timesteps``, ``n_envs``, ``policy``, ``normalize`` (a bool or
-the zoo's string ``"dict(norm_obs=..., norm_reward=...)"``; the discount ``gamma`` is added, as
+checked by :mod:`aerostat_gym.agents.hyperparams`): a block per registered task id (keys
+``n_timesteps``, ``n_envs``, ``policy``, ``normalize`` (a bool or the zoo's string ``"dict(norm_obs=..., norm_reward=...)"``; the discount ``gamma`` is added, as
 the zoo does), ``policy_kwargs``, ``noise_type`` / ``noise_std`` for TD3, the rest passed to the
 algorithm), trained on that task's registered conditions. Keys the zoo does not know live in a
 separate top-level block ``aerostat_gym``:

@@ -158,9 +158,10 @@ class EnvBatch:
         u_max = self.trims.speeds[-1] * _advection_factor(self.params, turb)
         need = field_length_needed(turb, u_max)
         # unit-variance fields, scaled per episode to its mean wind (episodes._intensity)
+        bank = unit_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
         self._bank_key = (repr(turb.unit()), self.task.wind_bank_size, self.task.wind_bank_seed,
-                          need)
-        return unit_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
+                          bank.shape)
+        return bank
 
     def release(self) -> None:
         """Drop this batch's reference to the turbulence bank (freed with its last user): the
@@ -298,7 +299,9 @@ class EnvBatch:
         settings of the configuration vector, the observation's layout, bounds and noise.
         Equal arguments resolve to an equal world (``params=None`` and the baseline loaded,
         ``(8, 8)`` and ``8``); the integration scheme is not part of it (a snapshot may be
-        re-run on a finer step) and neither is a ``reward_fn``."""
+        re-run on a finer step or with the other integrator) and neither is a ``reward_fn``.
+        What the snapshot carries itself (the packed parameters of its episode: hull, tether,
+        winch dynamics) runs on as saved whatever this batch's parameters are."""
         c = self.cfg
         return {
             "turbulence fields": self._bank_key,
@@ -324,9 +327,9 @@ class EnvBatch:
         differ = [k for k in mine if world.get(k) != mine[k]]
         if differ:
             raise ValueError(
-                f"the snapshot comes from an environment whose {', '.join(differ)} differ from "
-                "this one's: restored here it would not go on as saved; restore it into an "
-                "environment made with the same arguments")
+                f"the snapshot comes from an environment of another world ({', '.join(differ)}):"
+                " restored here it would not go on as saved; restore it into an environment "
+                "made with the same arguments")
 
     def set_actions(self, actions) -> np.ndarray:
         """Validate and store actions (see :func:`coerce_actions`): NaN/inf is an ActionError,

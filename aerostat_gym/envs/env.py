@@ -303,8 +303,8 @@ class TetheredAerostatEnv(gym.Env):
       ground, winch and reward settings, observation bounds and noise), and ``set_state``
       refuses one whose world differs, naming what differs (a snapshot from another tether
       length with the same element count ran on with this env's reward band). Arguments
-      that resolve alike are the same world; another integration step is allowed (a re-run
-      on a finer step); snapshots of 0.7.15 and before are taken on trust.
+      that resolve alike are the same world; another integration step or integrator is
+      allowed (a re-run); snapshots of 0.7.15 and before are taken on trust.
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}
@@ -414,7 +414,7 @@ class TetheredAerostatEnv(gym.Env):
         """Restore a :meth:`get_state` snapshot; returns the observation saved with it. A
         snapshot of an environment with another world (see :meth:`get_state`) is refused,
         naming what differs, and leaves this one as it was; one taken on another integration
-        step is accepted (a re-run of the same state on a finer step)."""
+        step or with the other integrator is accepted (a re-run of the same state)."""
         if not isinstance(saved, dict) or "np_random" not in saved:
             raise ValueError("set_state expects a dict from get_state()")
         generator = type(self.np_random.bit_generator)()

@@ -74,7 +74,7 @@ Named modelling differences and their switches (``variant`` of :func:`prepare`)
 - ``"moordyn_drag"`` (drag law and lumping, our side): MoorDyn's nodal drag
   (:func:`moordyn_node_drag`: each node's own velocity and the tangent through its neighbours,
   Cd sin^2 and CdAx cos^2) replaces ours (loading functions on each element's midpoint
-  velocity, half to each end node) in the node accelerations (:func:`_apply_moordyn_drag`).
+  velocity, half to each end node) in the node accelerations (``driven._apply_moordyn_drag``).
 - ``"no_buoyancy"`` (buoyancy, MoorDyn's side): its line mass per length raised by
   rho_air A, so its submerged weight equals our weight (its inertia rises by 0.15 %).
 - ``"moordyn_slack_rule"`` (damping clip, our side): MoorDyn's segment force

@@ -35,7 +35,7 @@ class DynamicBenchError(ValueError):
 
 @dataclass(frozen=True)
 class DrivenCase:
-    """One prescribed top-end motion (see the module docstring).
+    """One prescribed top-end motion (see :mod:`aerostat_gym.bench.moordyn_dynamic`).
 
     Parameters
     ----------

@@ -76,7 +76,8 @@ def correlation_lag(ours: np.ndarray, ref: np.ndarray, dt: float, max_lag: float
 
 
 def compare_runs(ours: dict, ref: dict, case: DrivenCase, length: float) -> dict:
-    """Figures of ``ours`` against ``ref`` over the case's window (module docstring)."""
+    """Figures of ``ours`` against ``ref`` over the case's window
+    (:mod:`aerostat_gym.bench.moordyn_dynamic`, Figures)."""
     t = np.arange(len(ref["top"])) * OUTPUT_DT
     win = t >= case.window_start - 1e-9
     d = np.linalg.norm(ours["nodes"][win, 1:-1] - ref["nodes"][win, 1:-1], axis=2)

@@ -303,7 +303,7 @@ def _set_length_rate(md, line, rate: float) -> None:
 
 def _sample_moordyn(md, line, N: int, shift: np.ndarray, out: dict) -> None:
     """Append MoorDyn's node positions (our frame and order, top first), end tensions (the
-    definitions of :func:`aerostat_gym.bench.moordyn.run_moordyn`) and slack segment count."""
+    definitions of the static comparison, :mod:`aerostat_gym.bench.moordyn`) and slack segment count."""
     nodes = np.array([md.GetLineNodePos(line, i) for i in range(N, -1, -1)]) + shift
     out["nodes"].append(nodes)
     out["top"].append(float(np.linalg.norm(md.GetLineNodeForce(line, N))))
