@@ -253,7 +253,7 @@ def test_suite_at_other_speeds_is_the_suite_cell_it_replaces():
         evaluate_policy,
         suite_cells,
     )
-    from aerostat_gym.agents.lqr import schedule_speeds
+    from aerostat_gym.agents.scheduling import schedule_speeds
 
     assert suite_cells("tiny", [18, 10]) == {"recover": ([10.0, 18.0], [0]),
                                             "gusty": ([10.0, 18.0], [100, 101])}
@@ -277,7 +277,7 @@ def test_suite_at_other_speeds_is_the_suite_cell_it_replaces():
 
 
 def test_scheduled_controllers_are_the_braked_winch_in_still_air_and_say_so():
-    """At U = 0 the gains fade to zero (agents.lqr.low_wind_fade: no linear authority over a
+    """At U = 0 the gains fade to zero (agents.scheduling.low_wind_fade: no linear authority over a
     vertical tether's pendulum): the LQR's still-air recovery is the braked winch's, sample
     for sample, and the evaluator warns rather than let the identical rows pass unexplained."""
     with pytest.warns(UserWarning, match="U = 0 m/s.*no linear authority"):

@@ -16,9 +16,9 @@ from aerostat_gym.agents.lqr import (
     bryson_weights,
     design_lqr,
     mode_initial_state,
-    set_point_law,
 )
 from aerostat_gym.agents.metrics import fit_damped_sinusoid
+from aerostat_gym.agents.privileged import set_point_law
 from aerostat_gym.envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND
 from aerostat_gym.params import load_params
 from aerostat_gym.physics.state import StateLayout

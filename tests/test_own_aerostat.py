@@ -35,10 +35,10 @@ from aerostat_gym.agents.lqr import (
     LQRSchedule,
     mode_initial_state,
     scaled_deviations,
-    set_point_law,
 )
 from aerostat_gym.agents.metrics import fit_damped_sinusoid
 from aerostat_gym.agents.policies import load_policy
+from aerostat_gym.agents.privileged import set_point_law
 from aerostat_gym.agents.train import held_training_winds
 from aerostat_gym.analysis.figures import family_values, figure8_data
 from aerostat_gym.analysis.linear import ACTUATORS, U_FREE, input_jacobian
@@ -791,8 +791,8 @@ def test_schedules_stop_where_the_winch_motor_cannot_hold_the_trim():
     trim winch tension is at most the motor force (the next speed's is above it) and run there;
     a motor that holds no trim at all is a clear design error."""
     from aerostat_gym.agents.lqg import LQGSchedule
-    from aerostat_gym.agents.lqr import LQRDesignError, held_trims
     from aerostat_gym.agents.modal import ModalSchedule
+    from aerostat_gym.agents.scheduling import LQRDesignError, held_trims
 
     p = scale_aerostat(load_params(), volume_factor=0.01, tether_length=40.0, n_elements=4)
     fmax = p.winch.max_motor_force

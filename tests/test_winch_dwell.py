@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from aerostat_gym.agents.frontier import initial_state, swing_response
-from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule, set_point_law
+from aerostat_gym.agents.lqr import LQRPolicy, LQRSchedule
+from aerostat_gym.agents.privileged import set_point_law
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
 from aerostat_gym.params import load_params
 from aerostat_gym.physics.state import StateLayout

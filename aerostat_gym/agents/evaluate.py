@@ -411,7 +411,7 @@ def warn_still_air(policy_name: str, cells: dict) -> None:
         warnings.warn(f"{policy_name} at U = 0 m/s: in still air the tether hangs vertical and "
                       "reeling moves the aerostat along it, so the winch has no linear authority "
                       "over the pendulum; the scheduled controllers fade to the braked winch "
-                      "there (agents.lqr.low_wind_fade) and read as passive", UserWarning,
+                      "there (agents.scheduling.low_wind_fade) and read as passive", UserWarning,
                       stacklevel=3)
 
 

@@ -51,15 +51,9 @@ from ..envs.spaces import CHANNELS, N_OBS, OBS_INDEX, OBS_WIND_X, as_batch, chec
 from ..params import Params
 from ..physics.state import S_Q, S_THETA, S_VX, S_VZ, S_X, S_Z, StateLayout
 from ..sim import Model
-from .lqr import (
-    DEFAULT_SPEEDS,
-    LQRDesign,
-    design_lqr,
-    discretize,
-    held_trims,
-    scheduled_tables,
-)
+from .lqr import LQRDesign, design_lqr, discretize
 from .modal import design_modal
+from .scheduling import DEFAULT_SPEEDS, held_trims, scheduled_tables
 from .state_check import check_state_passed
 
 #: Standard observation channels the filter uses (name -> index), all longitudinal.
@@ -300,7 +294,8 @@ class LQGSchedule:
         Model parameters.
     speeds : array_like or None
         Design speeds [m/s], increasing (default 2 to 16 m/s in 1 m/s steps); those whose
-        trim the winch motor cannot hold are dropped (:func:`~aerostat_gym.agents.lqr.held_trims`).
+        trim the winch motor cannot hold are dropped
+        (:func:`~aerostat_gym.agents.scheduling.held_trims`).
     dt : float
         Control step [s].
     obs_noise : float
@@ -326,7 +321,7 @@ class LQGSchedule:
     def lookup(self, U: np.ndarray, names=None) -> dict:
         """The tables ``names`` (default every one) at the speeds U (N,), linear in U between
         the design speeds; the feedback gains (K, K_integral) faded below the lowest one, the
-        filter's tables not (:func:`~aerostat_gym.agents.lqr.scheduled_tables`)."""
+        filter's tables not (:func:`~aerostat_gym.agents.scheduling.scheduled_tables`)."""
         tables = {k: self.tables[k] for k in (names or self.tables)}
         return scheduled_tables(self.speeds, tables, U, FEEDBACK_TABLES)
 

@@ -35,7 +35,6 @@ a slow mode that the energy rule alone would also call "axial spring" or "pendul
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import time
@@ -59,8 +58,16 @@ from ..analysis.modes import (
 from ..analysis.trim import Equilibrium, find_equilibrium
 from ..checks import is_finite_number
 from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND, as_batch
-from ..params import Params, dumps_toml
+from ..params import Params
 from ..physics.state import S_PSI, StateLayout
+from .scheduling import (
+    DEFAULT_SPEEDS,
+    LQRDesignError,
+    held_trims,
+    params_fingerprint,
+    schedule_speeds,
+    scheduled_tables,
+)
 from .state_check import check_state_passed
 from .swing_plane import in_swing_plane
 
@@ -97,88 +104,10 @@ WEIGHTS_REFERENCE_LENGTH = 300.0
 _POSITION_WEIGHTS = ("node_pos", "cm_pos", "length", "length_integral")
 _VELOCITY_WEIGHTS = ("node_vel", "cm_vel", "roll_rate", "pitch_rate", "yaw_rate")
 
-#: Design wind speeds of the default schedule [m/s] (2, 3, ..., 16): the environment's default
-#: range 3-15 m/s with one step of margin on each side (:func:`schedule_speeds`).
-DEFAULT_SPEEDS = np.arange(2.0, 17.0, 1.0)
-DEFAULT_SPEEDS.setflags(write=False)
-#: Step of the design speeds and the margin beyond the wind range [m/s].
-SCHEDULE_STEP = 1.0
-
-
-def schedule_speeds(wind_range: tuple[float, float]) -> np.ndarray:
-    """Design speeds covering a wind range (low, high) [m/s] with one step of margin on each
-    side, never below 1 m/s (at zero wind the yaw mode is neutral); (3, 15) gives 2, 3, ..., 16."""
-    lo, hi = (float(v) for v in wind_range)
-    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo <= hi):
-        raise ValueError(f"wind range must be finite with 0 <= low <= high, got {wind_range!r}")
-    start = max(lo - SCHEDULE_STEP, 1.0)
-    n = int(math.ceil((hi + SCHEDULE_STEP - start) / SCHEDULE_STEP - 1e-9)) + 1
-    return start + SCHEDULE_STEP * np.arange(n)
-
-
-def low_wind_fade(U, lowest: float) -> np.ndarray:
-    """Factor on a schedule's feedback gains at wind speed U below its lowest design speed
-    ``lowest``: (U / lowest)^2, 1 from ``lowest`` up, 0 at zero wind (the braked winch).
-
-    Reeling moves the aerostat across the wind through the blow-by angle, whose tangent (drag
-    over net lift) grows as U^2 at low wind: the winch's authority over the pendulum at the
-    trim vanishes as U -> 0, and gains designed at ``lowest`` ask for reeling it cannot turn
-    into damping. Unfaded, they saturated the reel through a 10 m swing and the pendulum grew:
-    the modal controller at 1 m/s on its 2 m/s gains, zeta -0.031 against the braked winch's
-    0.034; faded with the authority, 0.041 (README, "Below the design range")."""
-    return np.clip(np.asarray(U, float) / lowest, 0.0, 1.0) ** 2
-
-
-def scheduled_tables(speeds: np.ndarray, tables: dict, U, faded=frozenset()) -> dict:
-    """Each table of ``tables`` (one row per design speed in ``speeds``) at the wind speeds U
-    (scalar or (N,)): linear in U between the design speeds, clamped to the end speeds; the
-    tables named in ``faded`` (feedback gains) times :func:`low_wind_fade` below the lowest."""
-    U = np.asarray(U, float)
-    if speeds.size == 1:
-        out = {k: np.broadcast_to(v[0], U.shape + v.shape[1:]) for k, v in tables.items()}
-    else:
-        Uc = np.clip(U, speeds[0], speeds[-1])
-        i = np.clip(np.searchsorted(speeds, Uc, side="right") - 1, 0, speeds.size - 2)
-        w = (Uc - speeds[i]) / (speeds[i + 1] - speeds[i])
-        out = {}
-        for k, v in tables.items():
-            ww = w.reshape(w.shape + (1,) * (v.ndim - 1))
-            out[k] = (1.0 - ww) * v[i] + ww * v[i + 1]
-    fade = low_wind_fade(U, speeds[0])
-    for k in set(faded).intersection(out):
-        out[k] = out[k] * fade.reshape(fade.shape + (1,) * (out[k].ndim - fade.ndim))
-    return out
-
-
-def held_trims(params: Params, speeds) -> list:
-    """(U, trim) at each design speed (non-negative, strictly increasing) whose trim the winch
-    motor holds: winch tension at most ``winch.max_motor_force``. Above that speed a feedback
-    design has no actuator (the over-hauled winch holds on its brake,
-    :func:`aerostat_gym.sim.winch.brake_rule`, and its linearization has no control over the
-    drum), so a schedule stops there and its gains stay those of the last held speed. Trims
-    by continuation in U. Raises LQRDesignError when the motor holds none of them."""
-    speeds = np.asarray(speeds, float).ravel()
-    if speeds.size == 0 or np.any(np.diff(speeds) <= 0) or np.any(speeds < 0):
-        raise ValueError(f"speeds must be non-negative and strictly increasing, got {speeds}")
-    fmax, held, eq = params.winch.max_motor_force, [], None
-    for U in speeds:
-        eq = find_equilibrium(params, float(U), guess=eq)
-        if eq.summary["winch_tension_N"] > fmax:
-            break
-        held.append((float(U), eq))
-    if not held:
-        raise LQRDesignError(f"the winch motor (winch.max_motor_force = {fmax:.0f} N) cannot "
-                             f"hold the trim at any design speed from {speeds[0]:g} m/s: no "
-                             "feedback design")
-    return held
-
 
 #: Long-period/short-period modes reported by :meth:`LQRDesign.summary`.
 NAMED_MODES = ("pendulum", "pitching", "axial spring")
 
-
-class LQRDesignError(RuntimeError):
-    """The Riccati equation could not be solved or the loop it gives is not stable."""
 
 
 def scaled_deviations(params: Params) -> dict:
@@ -502,10 +431,6 @@ def mode_initial_state(design: LQRDesign, label: str = "pendulum", amplitude: fl
 # --- schedule -------------------------------------------------------------------------------------
 
 
-def params_fingerprint(params: Params) -> str:
-    """SHA-256 of the parameter set's TOML text (identifies the model a schedule was built for)."""
-    return hashlib.sha256(dumps_toml(params).encode()).hexdigest()
-
 
 class LQRSchedule:
     """Table of LQR designs over mean wind speed; gains interpolated linearly in U.
@@ -601,46 +526,6 @@ class LQRSchedule:
         self.build_time_s = 0.0
         self.designs = None
         return self
-
-
-# --- running a privileged policy outside the environment ------------------------------------
-
-
-def full_observation(x: np.ndarray, x_trim: np.ndarray, wind_speed: float,
-                     layout: StateLayout) -> np.ndarray:
-    """The environment's ``observation="full"`` privileged part for a state outside it (e.g.
-    in :func:`aerostat_gym.sim.simulate`): zeros for the standard channels, the mean wind speed
-    at ``OBS_FULL_WIND`` and x - x_trim with the yaw wrapped to [-pi, pi) from
-    ``OBS_FULL_STATE``."""
-    dx = x - x_trim
-    i_psi = layout.at(S_PSI)
-    dx[i_psi] = (dx[i_psi] + np.pi) % (2.0 * np.pi) - np.pi
-    obs = np.zeros(OBS_FULL_STATE + layout.size)
-    obs[OBS_FULL_WIND], obs[OBS_FULL_STATE:] = wind_speed, dx
-    return obs
-
-
-def set_point_law(policy, x_trim: np.ndarray, wind_speed: float, params: Params,
-                  to_input=None, record: list | None = None, state=None):
-    """u(t, x) for :func:`aerostat_gym.sim.simulate` from a full-observation policy: the
-    policy's action times ``winch.max_speed``, through ``to_input(v)`` (default: the released
-    winch, [v, 0]). The policy's recurrent state travels between calls, starting from
-    ``state`` (None: a fresh episode; e.g. the LQR's length integral to start on a mode), and
-    each set-point is appended to ``record`` if given."""
-    layout = StateLayout(params.tether.n_elements)
-    vmax = float(params.winch.max_speed)
-    memo = {"state": state, "start": np.full(1, state is None)}
-
-    def u(t, x):
-        obs = full_observation(x, x_trim, wind_speed, layout)
-        a, memo["state"] = policy.predict(obs, memo["state"], memo["start"])
-        memo["start"][:] = False
-        v = float(np.clip(np.asarray(a).reshape(-1)[0], -1.0, 1.0)) * vmax
-        if record is not None:
-            record.append(v)
-        return [v, 0.0] if to_input is None else to_input(v)
-
-    return u
 
 
 # --- policy ---------------------------------------------------------------------------------------

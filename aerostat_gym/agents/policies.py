@@ -37,10 +37,11 @@ from ..envs.spaces import CHANNELS, N_OBS, OBS_DLENGTH, OBS_DTENSION, as_batch, 
 from ..params import MAX_WIND_SPEED, Params, as_params
 from ..resources import SHIPPED_POLICY, shipped_path
 from .lqg import LQGPolicy, LQGSchedule
-from .lqr import LQRPolicy, LQRSchedule, schedule_speeds
+from .lqr import LQRPolicy, LQRSchedule
 from .modal import ModalPolicy, ModalSchedule
 from .residual import ShapedPolicy, check_residual, residual_shaper
 from .sb3io import PolicyError, load_sb3, to_actions
+from .scheduling import schedule_speeds
 
 BASELINES = ("passive", "tension", "lqr", "modal", "lqg", "modal_lqg", "modal_lqg_shaped",
              "modal_lqg_lowpass")
