@@ -316,8 +316,8 @@ class EnvBatch:
 
     def _check_same_world(self, world: dict | None) -> None:
         """A snapshot runs on as saved only in a batch of the same world (:meth:`world`):
-        another one (another hull, winch, control step or turbulence) is refused, naming what
-        differs. A snapshot without its world (taken before aerostat-gym 0.7.16) is taken on
+        another one (another control step, turbulence, ground height, winch limits, reward or
+        observation) is refused, naming what differs. A snapshot without its world (taken before aerostat-gym 0.7.16) is taken on
         trust."""
         if world is None:
             return
