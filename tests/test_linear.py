@@ -32,6 +32,7 @@ from aerostat_gym.analysis.modes import (
     energy_vector,
     mac,
     mode_context,
+    wind_sweep,
 )
 from aerostat_gym.analysis.reference import (
     TABLE2,
@@ -41,7 +42,6 @@ from aerostat_gym.analysis.reference import (
     tether_mass_periods,
 )
 from aerostat_gym.analysis.sensitivity import default_knobs, solve_for_period, stability_figures
-from aerostat_gym.analysis.sweeps import wind_sweep
 from aerostat_gym.analysis.trim import TrimLimitError, find_equilibrium
 from aerostat_gym.bench.linear import bench_sweep
 from aerostat_gym.cli.stability import _fmt, add_stability_parsers, parse_speeds

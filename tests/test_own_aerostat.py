@@ -42,7 +42,7 @@ from aerostat_gym.agents.privileged import set_point_law
 from aerostat_gym.agents.train import held_training_winds
 from aerostat_gym.analysis.figures import family_values, figure8_data
 from aerostat_gym.analysis.linear import ACTUATORS, U_FREE, input_jacobian
-from aerostat_gym.analysis.modes import analyse
+from aerostat_gym.analysis.modes import analyse, wind_sweep
 from aerostat_gym.analysis.reference import (
     THEORY_TOLERANCE_PCT,
     closed_form_periods,
@@ -51,7 +51,6 @@ from aerostat_gym.analysis.reference import (
     veering_allowance,
 )
 from aerostat_gym.analysis.sensitivity import default_knobs
-from aerostat_gym.analysis.sweeps import wind_sweep
 from aerostat_gym.analysis.trim import TrimError, find_equilibrium
 from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main

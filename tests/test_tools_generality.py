@@ -18,7 +18,7 @@ from aerostat_gym.analysis.figures import (
     isolated_points,
     period_limits,
 )
-from aerostat_gym.analysis.sweeps import wind_sweep
+from aerostat_gym.analysis.modes import wind_sweep
 from aerostat_gym.cli import main
 from aerostat_gym.params import load_params
 from aerostat_gym.scaling import scale_aerostat

@@ -19,8 +19,7 @@ from ..extras import agg_pyplot
 from ..params import Params, load_params
 from ..sim import Model, simulate
 from .linear import linearize, propagate
-from .modes import FIGURE9_MODES, SETS
-from .sweeps import Sweep, wind_sweep
+from .modes import FIGURE9_MODES, SETS, Sweep, wind_sweep
 from .trim import find_equilibrium
 
 #: Figure 8 variables: aerostat CM position and Euler angles, with their units.

@@ -11,14 +11,14 @@ import time
 
 import numpy as np
 
-from ..analysis.sweeps import wind_sweep
+from ..analysis.modes import wind_sweep
 from ..params import Params, load_params
 
 BUDGET_S = 10.0
 
 
 def bench_sweep(params: Params | None = None, speeds=None, repeats: int = 3) -> dict:
-    """Median wall time of :func:`~aerostat_gym.analysis.sweeps.wind_sweep` (trim by
+    """Median wall time of :func:`~aerostat_gym.analysis.modes.wind_sweep` (trim by
     continuation, finite-difference linearization, decoupling, both modal tables,
     classification and MAC tracking at every speed).
 

@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from ..analysis.figures import figure9_data, write_figure9
-from ..analysis.modes import FIGURE9_MODES, SET_NAMES, SETS
+from ..analysis.modes import FIGURE9_MODES, SET_NAMES, SETS, wind_sweep
 from ..analysis.reference import format_table2, table2
 from ..analysis.sensitivity import (
     DAMPING_SPEEDS,
@@ -33,7 +33,6 @@ from ..analysis.sensitivity import (
     select_knobs,
     sensitivity_table,
 )
-from ..analysis.sweeps import wind_sweep
 from ..analysis.trim import TrimLimitError, find_equilibrium, limit_warnings
 from ..extras import require_plotting
 from ..params import MAX_WIND_SPEED
