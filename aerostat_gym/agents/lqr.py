@@ -60,6 +60,8 @@ from ..checks import is_finite_number
 from ..envs.spaces import OBS_FULL_STATE, OBS_FULL_WIND, as_batch
 from ..params import Params
 from ..physics.state import S_PSI, StateLayout
+from .privileged import full_observation as full_observation  # the 'as' imports: names
+from .privileged import set_point_law as set_point_law  # importable from lqr as before 0.7.16
 from .scheduling import (
     DEFAULT_SPEEDS,
     LQRDesignError,
@@ -68,6 +70,8 @@ from .scheduling import (
     schedule_speeds,
     scheduled_tables,
 )
+from .scheduling import SCHEDULE_STEP as SCHEDULE_STEP
+from .scheduling import low_wind_fade as low_wind_fade
 from .state_check import check_state_passed
 from .swing_plane import in_swing_plane
 

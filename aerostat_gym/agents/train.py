@@ -81,6 +81,16 @@ from .hyperparams import (
     load_hyperparams,
     refused,
 )
+from .hyperparams import ALGO_RANGES as ALGO_RANGES  # this and the other 'as' imports: importable
+from .hyperparams import ALGOS as ALGOS  # from train as before hyperparams.py (0.7.15 and earlier)
+from .hyperparams import COUNT as COUNT
+from .hyperparams import HYPERPARAMETER_RANGES as HYPERPARAMETER_RANGES
+from .hyperparams import NON_NEGATIVE as NON_NEGATIVE
+from .hyperparams import NORMALIZE_RANGES as NORMALIZE_RANGES
+from .hyperparams import OPTIONAL_POSITIVE as OPTIONAL_POSITIVE
+from .hyperparams import POSITIVE as POSITIVE
+from .hyperparams import PROJECT_KEYS as PROJECT_KEYS
+from .hyperparams import normalize_kwargs as normalize_kwargs
 from .policies import load_policy
 from .report import plot_training_curve
 from .residual import check_residual, residual_shaper, residual_vec_env

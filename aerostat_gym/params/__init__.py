@@ -46,6 +46,9 @@ from .files import (
     status_comments,
     status_slips,
 )
+
+# importable from here as before the split into modules (0.7.15 and earlier)
+from .files import tomllib as tomllib
 from .model import (
     Params,
     apply_overrides,
