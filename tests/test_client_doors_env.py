@@ -3,6 +3,7 @@ call after close), the wind speed taken exactly as asked, bounded perturbations,
 grid refused before it is allocated, the vector env's seeds, and the native vector env's infos
 laid out as Gymnasium's SyncVectorEnv lays out the single env's."""
 
+import json
 import pickle
 import re
 import warnings
@@ -499,3 +500,6 @@ def test_a_snapshot_from_another_world_is_refused_naming_what_differs():
     finer = TetheredAerostatEnv(**calm, overrides={"simulation.semi_implicit_dt": 0.01})
     finer.set_state(saved)
     assert np.abs(finer.step([0.2])[0] - ref).max() < 0.05
+    # a world written to JSON and read back (tuples become lists) is the same world
+    twin.set_state({**saved, "world": json.loads(json.dumps(saved["world"]))})
+    assert np.array_equal(twin.step([0.2])[0], ref)

@@ -324,7 +324,7 @@ class EnvBatch:
         if not isinstance(world, dict):
             raise ValueError("simulator state's world is not a dict from get_state()")
         mine = self.world()
-        differ = [k for k in mine if world.get(k) != mine[k]]
+        differ = [k for k in mine if _as_lists(world.get(k)) != _as_lists(mine[k])]
         if differ:
             raise ValueError(
                 f"the snapshot comes from an environment of another world ({', '.join(differ)}):"
@@ -430,3 +430,11 @@ def trim_table(task: TaskConfig) -> TrimTable:
 def _advection_factor(params, turb) -> float:
     """U_a / U_ref for the configured mean profile (1 for the paper's uniform wind)."""
     return set_advection(mean_wind(params.wind, 1.0), turb.reference_height, 0.0)
+
+
+def _as_lists(value):
+    """``value`` with every tuple a list, recursively: a snapshot's world compares equal after
+    a trip through JSON or YAML (which write tuples as lists)."""
+    if isinstance(value, (tuple, list)):
+        return [_as_lists(v) for v in value]
+    return value
