@@ -785,6 +785,36 @@ def test_observation_limits_and_metrics_follow_a_heavy_aerostat():
     assert np.nanmax(ep.tension) > trim_T > 2.0e5  # the swing loads the tether above its trim
 
 
+def test_reel_speed_and_body_rate_limits_follow_the_winch_and_the_hull():
+    """A 3 m/s winch on the 32 m class: paying out at full command, the length grows at 3 m/s
+    and the reel-speed channel reads it (its limit is twice the top speed; it read 2.0, the
+    baseline's clip, before 0.7.17). A hull 4 times shorter than the baseline's has body-rate
+    limits of 2 rad/s x sqrt(4) (Froude); the baseline's are the table's 2 rad/s."""
+    from aerostat_gym.envs import TetheredAerostatEnv
+    from aerostat_gym.envs.spaces import CHANNELS, OBS_INDEX, bounds
+
+    p = load_params("tcom_32m", {"winch.max_speed": 3.0, "winch.max_acceleration": 2.0})
+    env = TetheredAerostatEnv(params=p, wind_speed=(10.0, 10.0), turbulence="none",
+                              perturbation="none")
+    env.reset(seed=0)
+    i_speed, i_length = OBS_INDEX["reel_speed"], OBS_INDEX["dlength"]
+    assert env.observation_space.high[i_speed] == pytest.approx(6.0)
+    for _ in range(15):  # 1.5 s at 2 m/s^2 reaches the top speed
+        obs = env.step([1.0])[0]
+    length = obs[i_length] * CHANNELS[i_length].scale
+    obs = env.step([1.0])[0]
+    paid = (obs[i_length] * CHANNELS[i_length].scale - length) / env.task.control_step
+    assert paid == pytest.approx(3.0, rel=1e-3)
+    assert obs[i_speed] * CHANNELS[i_speed].scale == pytest.approx(3.0, rel=1e-3)
+    short = scale_aerostat(load_params(), volume_factor=1 / 64, tether_length=75.0,
+                           n_elements=6)
+    assert short.aerostat.length == pytest.approx(18.3 / 4, rel=1e-3)
+    hi, base_hi = bounds(0, short)[1], bounds(0)[1]
+    for rate in ("p", "q", "r"):
+        assert base_hi[OBS_INDEX[rate]] * CHANNELS[OBS_INDEX[rate]].scale == pytest.approx(2.0)
+        assert hi[OBS_INDEX[rate]] == pytest.approx(2.0 * base_hi[OBS_INDEX[rate]], rel=1e-3)
+
+
 def test_schedules_stop_where_the_winch_motor_cannot_hold_the_trim():
     """0.01 x the baseline's volume on 40 m: its winch motor (8 kN x 0.01 = 80 N) cannot hold
     the trim from about 12 m/s. The LQR, modal and LQG schedules keep the design speeds whose

@@ -10,11 +10,13 @@ body rates p, q, r about the body x (nose), y and z axes; a positive reel speed 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..checks import is_finite_number
+from ..params.steps import SEMI_IMPLICIT_REFERENCE_HULL_LENGTH
 
 #: The tether length [m] the task's sizes are stated for (the baseline's 300 m): the
 #: perturbation presets' displacements (:data:`aerostat_gym.envs.config.PERTURBATIONS`), the
@@ -25,6 +27,10 @@ from ..checks import is_finite_number
 #: the evaluator's fits assume) and scores it as the baseline does. The channels' scales below
 #: stay the baseline's on every aerostat.
 REFERENCE_TETHER_LENGTH = 300.0
+#: The hull length [m] the body-rate limits are stated for (the baseline's; see SIZED_CHANNELS).
+REFERENCE_HULL_LENGTH = SEMI_IMPLICIT_REFERENCE_HULL_LENGTH
+#: Body-rate clip limit [rad/s] on the reference hull.
+RATE_LIMIT = 2.0
 
 
 def displacement_scale(tether_length: float | None) -> float:
@@ -62,9 +68,9 @@ CHANNELS: tuple[Channel, ...] = (
     _ch("dpitch", "pitch theta minus trim (theta < 0 is nose up: positive is nose down)", "rad",
         0.05, np.pi),
     _ch("dyaw", "yaw psi minus trim, wrapped to [-pi, pi]", "rad", 0.05, np.pi),
-    _ch("p", "body roll rate", "rad/s", 0.02, 2.0),
-    _ch("q", "body pitch rate", "rad/s", 0.02, 2.0),
-    _ch("r", "body yaw rate", "rad/s", 0.02, 2.0),
+    _ch("p", "body roll rate", "rad/s", 0.02, RATE_LIMIT),
+    _ch("q", "body pitch rate", "rad/s", 0.02, RATE_LIMIT),
+    _ch("r", "body yaw rate", "rad/s", 0.02, RATE_LIMIT),
     _ch("tension", "winch tension (load cell, winch-end tether tension)", "N", 1.0e4, 1.0e5,
         0.0),
     _ch("dtension", "winch tension minus its trim value", "N", 1.0e3, 1.0e5),
@@ -110,8 +116,11 @@ def observation_table(full_state_size: int = 0) -> list[dict]:
 
 #: Channels whose clip limit grows with the configured aerostat, and the SI limit each needs:
 #: positions reach the winch's longest line, the length channel its whole range, the tension
-#: channels twice the tether strength (a break is at 1x). A limit never shrinks below the
-#: table's (sized for [LN02]'s baseline, whose space is therefore unchanged).
+#: channels twice the tether strength (a break is at 1x), the reel speed twice the winch's top
+#: speed, and the body rates the table's 2 rad/s times sqrt(18.3 m / hull length) (Froude
+#: similarity: a hull k times shorter turns sqrt(k) times faster in the same disturbance). A
+#: limit never shrinks below the table's (sized for [LN02]'s baseline, whose space is
+#: therefore unchanged).
 SIZED_CHANNELS = {
     "dx": lambda p: p.winch.max_length,
     "dy": lambda p: p.winch.max_length,
@@ -119,7 +128,17 @@ SIZED_CHANNELS = {
     "dlength": lambda p: p.winch.max_length - p.winch.min_length,
     "tension": lambda p: 2.0 * p.tether.strength,
     "dtension": lambda p: 2.0 * p.tether.strength,
+    "reel_speed": lambda p: 2.0 * p.winch.max_speed,
+    "p": lambda p: _froude_rate_limit(p),
+    "q": lambda p: _froude_rate_limit(p),
+    "r": lambda p: _froude_rate_limit(p),
 }
+
+
+def _froude_rate_limit(params) -> float:
+    """Body-rate clip limit [rad/s] for ``params``' hull: the table's, sized for the 18.3 m
+    baseline, times sqrt(18.3 m / hull length)."""
+    return RATE_LIMIT * math.sqrt(REFERENCE_HULL_LENGTH / params.aerostat.length)
 
 
 def bounds(full_state_size: int = 0, params=None) -> tuple[np.ndarray, np.ndarray]:
