@@ -139,3 +139,19 @@ def test_numpy_scalars_and_0_d_arrays_are_numbers_at_the_env_door():
     assert task.resolved["wind_speed"] == (10.0, 10.0)
     spec = TaskConfig.from_kwargs(randomize={"aerostat.mass": np.float32(0.01)}).resolved
     assert spec["randomize"]["aerostat.mass"] == pytest.approx(0.01)
+
+
+def test_json_text_writes_non_finite_numbers_as_null():
+    """aerostat_gym.jsonout: NaN and infinities (Python floats, numpy scalars, inside arrays,
+    tuples and dicts) become null, numpy numbers plain numbers; the text parses as strict
+    JSON and finite values come back exactly."""
+    import json
+
+    from aerostat_gym import jsonout
+
+    value = {"a": float("nan"), "b": (1.5, np.float32(0.25), np.inf), "c": np.array([2.0, -np.inf]),
+             "d": [np.int64(3), {"e": np.float64(-np.nan)}], "f": "text", "g": None, "h": True}
+    text = jsonout.dumps(value)
+    back = json.loads(text, parse_constant=lambda token: pytest.fail(f"{token} in {text}"))
+    assert back == {"a": None, "b": [1.5, 0.25, None], "c": [2.0, None],
+                    "d": [3, {"e": None}], "f": "text", "g": None, "h": True}

@@ -406,6 +406,29 @@ def test_cli_stability_and_table2(capsys, tmp_path):
     assert [r["key"] for r in rows] == list(TABLE2)
 
 
+def _strict_json(text):
+    """Parse ``text`` as strict JSON (as JavaScript's JSON.parse does): NaN and Infinity are
+    refused."""
+    def refuse(token):
+        raise ValueError(f"{token} is not JSON")
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_json_of_an_overdamped_mode_is_strict_json(capsys):
+    """With hull.eta_k = 0.6 the lateral pendulum at 1 m/s is a real root (no period, no
+    damping ratio): ``table2 --json`` writes those cells as null, not Python's bare NaN that
+    strict parsers refuse (it did before 0.7.17); the text table says ``n/a``."""
+    assert _cli(["table2", "--json", "--set", "hull.eta_k=0.6"]) == 0
+    rows = {r["key"]: r for r in _strict_json(capsys.readouterr().out)}
+    assert rows["lat_pendulum"]["linear_s"] is None
+    assert rows["lat_pendulum"]["diff_pct"] is None
+    assert rows["lat_pendulum"]["linear_overdamped"] is True
+    assert rows["long_pendulum"]["linear_s"] == pytest.approx(rows["long_pendulum"]["theory_s"],
+                                                              rel=0.05)
+    assert _cli(["table2", "--set", "hull.eta_k=0.6"]) == 0
+    assert "n/a" in capsys.readouterr().out
+
+
 def test_stability_sweep_stops_where_the_tether_breaks(capsys):
     """The baseline's tether (35.6 kN) holds the 50 m/s trim and not the 60 m/s one (39.8 kN):
     ``--wind 40:60:10`` sweeps 40 and 50 m/s and warns where and why it stopped; a sweep of

@@ -32,11 +32,11 @@ fitted on the along-wind displacement, the lateral one on the cross-wind displac
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
 
+from .. import jsonout
 from ..checks import is_number
 from .evaluate import SCENARIOS
 from .policies import BASELINES
@@ -364,18 +364,10 @@ def protocol_markdown(proto: dict, reference: str = "passive",
     return "\n".join(parts)
 
 
-def json_safe(value):
-    """``value`` with every non-finite float replaced by None, through dicts, lists and tuples
-    (JSON has no NaN)."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: json_safe(x) for k, x in value.items()}
-    if isinstance(value, list | tuple):
-        return [json_safe(x) for x in value]
-    return value
+#: Importable from here as before 0.7.17.
+json_safe = jsonout.plain
 
 
 def dumps(proto: dict) -> str:
     """JSON text of :func:`protocol`'s output (NaN written as null)."""
-    return json.dumps(json_safe(proto), indent=1)
+    return jsonout.dumps(proto, indent=1)

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import jsonout
 from ..checks import is_number
 from ..extras import agg_pyplot
 from ..resources import SHIPPED_POLICY
@@ -279,7 +280,7 @@ def write_report(results: list[dict], out: str | Path, title: str, command: str,
         (out / "protocol.json").write_text(proto_mod.dumps(proto))
     md = out / "report.md"
     md.write_text("\n".join(parts))
-    (out / "report.json").write_text(json.dumps(jsonable(results, proto), indent=1))
+    (out / "report.json").write_text(jsonout.dumps(jsonable(results, proto), indent=1))
     return md
 
 

@@ -60,7 +60,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
+from .. import __version__, jsonout
 from ..checks import is_finite_number, is_whole
 from ..envs.batch import held_wind_top
 from ..envs.config import TaskConfig
@@ -271,7 +271,7 @@ def train(algo: str, hyperparams: str | Path | None = None, timesteps: int | Non
                "wall_time_s": wall, "steps_per_s": timesteps / wall,
                "machine": platform.processor() or platform.machine(),
                "threads": torch.get_num_threads()}
-    (run / "training_summary.json").write_text(json.dumps(summary, indent=2))
+    (run / "training_summary.json").write_text(jsonout.dumps(summary, indent=2))
     if suite_cb.history:
         plot_training_curve(suite_cb.history, run, f"{algo} on {task_id}, seed {seed}: score on "
                             f"the '{project.get('eval_suite', 'tiny')}' suite")
@@ -329,7 +329,7 @@ def suite_eval_callback(suite: str, freq: int, run: Path, params=None, on_eval=N
             self.logger.record("eval/suite_score", score)
             self.history.append({"timesteps": int(self.num_timesteps), "score": score,
                                  "wall_time_s": time.perf_counter() - self.t0})
-            (Path(run) / "evaluations.json").write_text(json.dumps(self.history, indent=1))
+            (Path(run) / "evaluations.json").write_text(jsonout.dumps(self.history, indent=1))
             best = score > self.best
             if best:
                 self.best = score

@@ -8,13 +8,13 @@ lazily with the Agg backend, so the package never needs a display or matplotlib 
 from __future__ import annotations
 
 import csv
-import json
 import math
 from pathlib import Path
 
 import numpy as np
 from scipy.linalg import expm
 
+from .. import jsonout
 from ..extras import agg_pyplot
 from ..params import Params, load_params
 from ..sim import Model, simulate
@@ -282,7 +282,7 @@ def write_table(rows: list[dict], path: str | Path) -> Path:
         w = csv.DictWriter(fh, fieldnames=keys)
         w.writeheader()
         for r in rows:
-            w.writerow({k: json.dumps(v) if isinstance(v, (dict, list)) else v for k, v in r.items()})
+            w.writerow({k: jsonout.dumps(v) if isinstance(v, (dict, list)) else v for k, v in r.items()})
     return path
 
 
@@ -418,7 +418,7 @@ def write_figure9(out_dir: str | Path, params: Params | None = None, speeds=None
     out.mkdir(parents=True, exist_ok=True)
     sweep = sweep or wind_sweep(params, speeds)
     data = figure9_data(sweep)
-    (out / "figure9.json").write_text(json.dumps(data, indent=1))
+    (out / "figure9.json").write_text(jsonout.dumps(data, indent=1))
     write_table(figure9_rows(data), out / "figure9.csv")
     write_table(sweep.rows(), out / "figure9_modes.csv")
     plot_figure9(data, out / "figure9.png")
@@ -434,7 +434,7 @@ def write_figure8(out_dir: str | Path, params: Params | None = None) -> dict:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     data = figure8_data(params)
-    (out / "figure8.json").write_text(json.dumps(data))
+    (out / "figure8.json").write_text(jsonout.dumps(data))
     write_table([{"variable": k, "nrms": v} for k, v in data["nrms"].items()], out / "figure8_nrms.csv")
     plot_figure8(data, out / "figure8.png")
     plot_figure8(figure8_data(params, tether_nodes="relaxed"), out / "figure8_relaxed_tether.png")
@@ -527,7 +527,7 @@ def write_families(out_dir: str | Path, params: Params | None = None, speeds=Non
     for name in FAMILIES:
         fam = family_data(params, name, None, speeds)
         stem = "family_" + name.replace(".", "_")
-        (out / f"{stem}.json").write_text(json.dumps({str(k): v for k, v in fam.items()}, indent=1))
+        (out / f"{stem}.json").write_text(jsonout.dumps({str(k): v for k, v in fam.items()}, indent=1))
         plot_family(fam, name, out / f"{stem}.png")
         result[name] = fam
     return result

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 
+from .. import jsonout
 from ..agents.evaluate import SUITES, cells_wind_range, suite_cells
 from ..agents.hyperparams import ALGOS
 from ..agents.policies import BASELINES, SHIPPED, load_policy
@@ -123,7 +123,7 @@ def _evaluate_command(args) -> int:
     md = write_report(results, out, f"Evaluation on suite `{args.suite}`",
                       "aerostat-gym " + " ".join(sys.argv[1:]), plots=not args.no_plots)
     if args.json:
-        print(json.dumps(jsonable(results, protocol_for(results)), indent=1))
+        print(jsonout.dumps(jsonable(results, protocol_for(results)), indent=1))
     else:
         for scenario in results[0]["scenarios"]:
             print(f"{scenario}:\n{comparison_table(results, scenario)}\n")

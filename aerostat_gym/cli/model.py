@@ -3,8 +3,7 @@ status) and ``bench`` (speed and accuracy figures)."""
 
 from __future__ import annotations
 
-import json
-
+from .. import jsonout
 from ..analysis.trim import find_equilibrium, limit_warnings
 from ..bench import format_text, run_bench
 from ..bench.moordyn_dynamic import format_report, run_dynamic_comparison
@@ -19,7 +18,7 @@ def cmd_trim(args) -> int:
         warn("trim", message)
     s = dict(eq.summary, relative_residual=eq.residual)
     if args.json:
-        print(json.dumps(s, indent=2))
+        print(jsonout.dumps(s, indent=2))
         return 0
     print(f"Trim at U = {args.wind:g} m/s (relative residual {eq.residual:.1e})")
     x, y, z = s["aerostat_position_m"]
@@ -35,7 +34,7 @@ def cmd_trim(args) -> int:
 def cmd_params(args) -> int:
     rows = parameter_table(params_from_args(args))
     if args.json:
-        print(json.dumps(rows, indent=2, default=str))
+        print(jsonout.dumps(rows, indent=2, default=str))
         return 0
     for r in rows:
         print(f"{r['name']:34s} {str(r['value']):>28s} {r['unit']:8s} {r['status']:8s} {r['description']}")
@@ -45,10 +44,10 @@ def cmd_params(args) -> int:
 def cmd_bench(args) -> int:
     if args.moordyn_dynamic:  # the tether in motion against MoorDyn (bench extra)
         res = run_dynamic_comparison(quick=args.quick)
-        print(json.dumps(res, indent=2, default=float) if args.json else format_report(res))
+        print(jsonout.dumps(res, indent=2, default=float) if args.json else format_report(res))
         return 0
     res = run_bench(quick=args.quick)
-    print(json.dumps(res, indent=2) if args.json else format_text(res))
+    print(jsonout.dumps(res, indent=2) if args.json else format_text(res))
     return 0
 
 

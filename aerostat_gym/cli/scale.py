@@ -9,13 +9,13 @@ CLI prints as one line and turns into exit status 2.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from pathlib import Path
 
 import numpy as np
 
+from .. import jsonout
 from ..agents.hyperparams import ALGOS, load_hyperparams
 from ..extras import require, require_plotting
 from ..resources import shipped_path
@@ -105,7 +105,7 @@ def montecarlo_command(args: argparse.Namespace) -> int:
     if args.bench:
         res = throughput(base, ranges, args.samples, args.seed, speeds, args.workers or 2,
                          args.batch_size, args.repeats)
-        print(json.dumps(res, indent=2) if args.json else format_throughput(res))
+        print(jsonout.dumps(res, indent=2) if args.json else format_throughput(res))
         return 0
     if args.serial:
         study = run_serial(base, ranges, args.samples, args.seed, speeds, _progress)
@@ -119,7 +119,7 @@ def montecarlo_command(args: argparse.Namespace) -> int:
     out = Path(args.out or f"runs/montecarlo/seed{args.seed}_n{args.samples}")
     files = write_outputs(study, summary, out, plot=not args.no_plot)
     if args.json:
-        print(json.dumps(summary, indent=1, default=float))
+        print(jsonout.dumps(summary, indent=1, default=float))
     else:
         print(format_summary(summary))
         print("wrote " + ", ".join(str(f) for f in files))
@@ -260,7 +260,7 @@ def run_tune_command(args: argparse.Namespace) -> int:
                          args.cpus_per_trial, args.address, args.workers)
     res = run_search(setup, opts, Path(args.out))
     if args.json:
-        print(json.dumps({k: res[k] for k in ("table", "best")}, indent=1))
+        print(jsonout.dumps({k: res[k] for k in ("table", "best")}, indent=1))
         return 0
     print(format_table(res["table"]))
     if res["best"].get("model"):

@@ -18,11 +18,11 @@ and exits with status 2).
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
 
+from .. import jsonout
 from ..analysis.figures import figure9_data, write_figure9
 from ..analysis.modes import FIGURE9_MODES, SET_NAMES, SETS, wind_sweep
 from ..analysis.reference import format_table2, table2
@@ -195,7 +195,7 @@ def cmd_stability(args) -> int:
                "unstable_modes": _unstable_json(sweep),
                "coupling_ratios": ratios, "figure9": figure9_data(sweep),
                "modes": sweep.rows()}
-        print(json.dumps(out, indent=1, default=_json_default))
+        print(jsonout.dumps(out, indent=1))
     else:
         print(f"Linear stability, L = {params.tether.length:g} m, n = {params.tether.n_elements}, "
               f"trim pitch {params.aerostat.trim_pitch_deg:g} deg")
@@ -203,17 +203,9 @@ def cmd_stability(args) -> int:
     return 0
 
 
-def _json_default(v):
-    if isinstance(v, (np.floating, np.integer)):
-        return v.item()
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    raise TypeError(f"not JSON serialisable: {type(v)}")
-
-
 def cmd_table2(args) -> int:
     rows = table2(stability_params(args))
-    print(json.dumps(rows, indent=1) if args.json else format_table2(rows))
+    print(jsonout.dumps(rows, indent=1) if args.json else format_table2(rows))
     return 0
 
 
@@ -224,7 +216,7 @@ def cmd_sensitivity(args) -> int:
         raise ValueError("sensitivity --wind speeds must be > 0 (at 0 m/s every mode is undamped)")
     knobs = select_knobs(default_knobs(params), args.knob)
     table = sensitivity_table(params, knobs, tuple(float(u) for u in speeds))
-    print(json.dumps(table, indent=1, default=_json_default) if args.json else format_sensitivity(table))
+    print(jsonout.dumps(table, indent=1) if args.json else format_sensitivity(table))
     return 0
 
 

@@ -7,13 +7,13 @@ Register with ``add_wind_parser(subparsers)``; the parser's ``func`` default is
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
 
 import numpy as np
 
+from .. import jsonout
 from ..agents.intensity import air_inertia_force
 from ..extras import agg_pyplot, require_plotting
 from ..params import MAX_WIND_SPEED
@@ -157,7 +157,7 @@ def wind_command(args) -> int:
     if not cfg.is_off:
         out.update(realised_statistics(cfg, wp, fields))
         out["air_inertia"] = _air_inertia(params, cfg, wp, wf, args.duration)
-    print(json.dumps(out, indent=2) if args.json else _table(out))
+    print(jsonout.dumps(out, indent=2) if args.json else _table(out))
     if args.plot:
         _plot(args.plot, cfg, wp, fields)
     return 0

@@ -5,12 +5,12 @@ follow; written as CSV, JSON and one figure."""
 from __future__ import annotations
 
 import csv
-import json
 import math
 from pathlib import Path
 
 import numpy as np
 
+from .. import jsonout
 from ..extras import agg_pyplot
 from .montecarlo import MODES, PERIOD_KEYS, Study
 from .stats import point_biserial, spearman, wilson_interval
@@ -209,7 +209,7 @@ def write_outputs(study: Study, summary: dict, out: Path, plot: bool = True) -> 
     _write_csv(files[0], sample_rows(study))
     _write_csv(files[1], summary["stability"])
     _write_csv(files[2], summary["correlations"], CORRELATION_FIELDS)
-    files[3].write_text(json.dumps(summary, indent=1, default=float))
+    files[3].write_text(jsonout.dumps(summary, indent=1, default=float))
     if plot:
         files.append(plot_study(study, summary, out / "montecarlo.png"))
     return files

@@ -35,6 +35,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
+from .. import jsonout
 from ..agents.hyperparams import PROJECT_BLOCK
 from ..agents.protocol_stats import bootstrap_mean_ci
 from ..agents.sb3io import vecnormalize_path
@@ -460,7 +461,7 @@ def _write_tables(trials: list[dict], table: list[dict], best: dict, out: Path) 
     if table:
         _csv(out / "tune_results.csv", table)
         files.append(out / "tune_results.csv")
-    (out / "tune_results.json").write_text(json.dumps(
+    (out / "tune_results.json").write_text(jsonout.dumps(
         {"table": table, "trials": trials, "best": best}, indent=1))
     files.append(out / "tune_results.json")
     return files
