@@ -407,3 +407,19 @@ def test_a_folder_given_as_the_parameter_file_is_named(tmp_path):
     with pytest.raises(ParameterError, match=rf"{re.escape(str(tmp_path))} is a folder: give a "
                        r"parameter file"):
         load_params(tmp_path)
+
+
+@pytest.mark.parametrize("name", ["shipped", "lqg", "lqr"])
+def test_a_policy_state_of_another_batch_size_is_refused_naming_both(name):
+    """A state returned for one observation, passed back with a batch of three: a ValueError
+    naming the shapes (for the LQG-based paths it was numpy's 'cannot reshape array of size
+    47 into shape (3,newaxis)')."""
+    policy = load_policy(name)
+    kwargs = {"observation": "full"} if name == "lqr" else {}
+    env = gym.make("TetheredAerostatRealistic-v0", **kwargs)
+    obs, _ = env.reset(seed=0)
+    _, state = policy.predict(obs, episode_start=np.array([True]))
+    expected = (r"state must hold one integral per environment, shape \(3,\), got \(1,\)"
+                if name == "lqr" else r"LQG state must have shape \(3, 47\) for 3 observation")
+    with pytest.raises(ValueError, match=expected):
+        policy.predict(np.stack([obs] * 3), state=state, episode_start=np.zeros(3, bool))

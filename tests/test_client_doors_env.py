@@ -17,6 +17,7 @@ from gymnasium.vector import AutoresetMode
 from aerostat_gym.envs import ENV_ID, TaskError, TetheredAerostatEnv
 from aerostat_gym.envs.vector import SB3_REASONS, SB3_RESET_PREFIX, TetheredAerostatVectorEnv
 from aerostat_gym.params import load_params
+from aerostat_gym.sim.events import TETHER_BREAK
 from aerostat_gym.wind.synthesis import MAX_FIELD_BYTES
 
 SMALL = {"n_elements": 5}  # a short tether discretisation: quick trims and steps
@@ -79,7 +80,8 @@ def test_render_before_reset_asks_for_reset():
     (lambda env: env.step([0.0]), "step()"),
     (lambda env: env.reset(seed=0), "reset()"),
     (lambda env: env.render(), "render()"),
-    (lambda env: env.set_state(env.get_state()), "set_state()"),
+    (lambda env: env.set_state({}), "set_state()"),
+    (lambda env: env.get_state(), "get_state()"),
 ])
 def test_single_env_refuses_every_call_after_close(call, name):
     """Without its turbulence bank a closed env would run in calm air while its infos report
@@ -92,6 +94,22 @@ def test_single_env_refuses_every_call_after_close(call, name):
     with pytest.raises(ClosedEnvironmentError, match=re.escape(
             f"{name} on a closed environment: close() released its turbulence fields")):
         call(env)
+
+
+def test_render_without_a_render_mode_is_refused_after_close_too():
+    """render() of an env made without a render_mode warns and returns None while it is
+    open; after close() it is refused as every other call (it returned None before 0.7.17)."""
+    env = TetheredAerostatEnv(**SMALL)
+    env.reset(seed=0)
+    env.close()
+    with pytest.raises(ClosedEnvironmentError, match=r"^render\(\) on a closed environment"):
+        env.render()
+    venv = _vector(2)
+    venv.reset(seed=0)
+    assert venv.render() is None
+    venv.close()
+    with pytest.raises(ClosedEnvironmentError, match=r"^render\(\) on a closed environment"):
+        venv.render()
 
 
 def test_vector_env_refuses_step_reset_and_render_after_close():
@@ -363,6 +381,41 @@ def test_native_vector_infos_are_sync_vector_infos(mode):
     assert count == {"terminated": 1, "truncated": 8} and reasons == ["tether_break"]
 
 
+def test_sb3_adapter_infos_are_dummy_vec_env_infos():
+    """Over 30 steps with breaks and time limits: sb3_vec_env's per-environment infos have the
+    keys and values of DummyVecEnv's over the single env (every step's reward terms, time, peak
+    tension, action_clipped and TimeLimit.truncated; an ended episode's reason and terminal
+    observation), and its reset_infos the new episodes'. Before 0.7.17 a running
+    environment's info was empty."""
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    from aerostat_gym.envs import sb3_vec_env
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the winch-motor warning of the weak tether
+        native = sb3_vec_env(4, seed=3, **EPISODES)
+        steps = EPISODES["max_episode_steps"]
+        task = {k: v for k, v in EPISODES.items() if k != "max_episode_steps"}
+        dummy = DummyVecEnv([lambda: gym.make(ENV_ID, max_episode_steps=steps, **task)] * 4)
+    dummy.seed(3)
+    assert np.array_equal(native.reset(), dummy.reset())
+    ends = []
+    for k in range(30):
+        a = np.full((4, 1), 0.3 * (-1) ** k, np.float32)
+        obs, rew, done, infos = native.step(a)
+        d_obs, d_rew, d_done, d_infos = dummy.step(a)
+        assert np.array_equal(obs, d_obs) and np.array_equal(rew, d_rew)
+        assert np.array_equal(done, d_done)
+        for i, (mine, theirs) in enumerate(zip(infos, d_infos, strict=True)):
+            assert set(mine) == set(theirs), (k, i, sorted(set(mine) ^ set(theirs)))
+            for key, value in theirs.items():
+                assert np.array_equal(mine[key], value), (k, i, key)
+            if done[i]:
+                ends.append(mine.get("termination", "time limit"))
+                assert native.reset_infos[i]["wind_speed"] == dummy.reset_infos[i]["wind_speed"]
+    assert sorted(set(ends)) == ["tether_break", "time limit"]
+
+
 def test_time_limit_sets_no_truncation_reason_but_time():
     """As the single env (its TimeLimit wrapper names no reason): no 'truncation' key."""
     venv = _vector(2, max_episode_steps=2, **{"turbulence": "none"})
@@ -459,6 +512,87 @@ def test_the_sb3_adapter_names_a_bad_seed_and_an_unknown_attribute():
         venv.get_attr("bogus")
     assert venv.get_attr("num_envs") == [2, 2]
     venv.close()
+
+
+def test_the_sb3_adapter_refuses_per_environment_calls_it_cannot_make():
+    """Its environments are slots of one batch: env_method is refused naming why (it called
+    the batch's method once per index, so env_method('reset', indices=[0]) reset both), and
+    set_attr for some environments only is refused; set_attr for all sets the batch's."""
+    from aerostat_gym.envs import sb3_vec_env
+    venv = sb3_vec_env(2, seed=0, **SMALL)
+    obs = venv.reset()
+    with pytest.raises(AttributeError, match=r"env_method\('reset'\): sb3_vec_env steps one "
+                                             "compiled batch and has no per-environment"):
+        venv.env_method("reset", indices=[0])
+    assert np.array_equal(venv.venv.batch.obs, obs)  # nothing was reset
+    with pytest.raises(ValueError, match=r"set_attr\('spec', indices=\[1\]\): the "
+                                         "environments of sb3_vec_env share one batch"):
+        venv.set_attr("spec", None, indices=[1])
+    venv.set_attr("spec", "mine")
+    assert venv.get_attr("spec") == ["mine", "mine"]
+
+
+def test_a_snapshot_restores_into_a_fresh_gym_make_env_through_reset():
+    """A planner's pattern on environments made by gym.make: reset(options={"snapshot": s})
+    restores s through the wrappers' reset (Gymnasium's order check refuses a step after
+    env.unwrapped.set_state on an env never reset, and its env checker fails on it), and the
+    steps that follow are bit-identical; the reset info is the episode's. With a seed or
+    another option, or from an ended episode, it is refused."""
+    env = gym.make(ENV_ID, **CALM)
+    _, started = env.reset(seed=4)
+    env.step(np.array([0.3], np.float32))
+    saved = env.unwrapped.get_state()
+    ref = env.step(np.array([-0.2], np.float32))
+    fresh = gym.make(ENV_ID, **CALM)
+    obs, info = fresh.reset(options={"snapshot": saved})
+    assert np.array_equal(obs, saved["obs"]) and info == started
+    out = fresh.step(np.array([-0.2], np.float32))
+    assert np.array_equal(out[0], ref[0]) and out[1] == ref[1] and out[4] == ref[4]
+    with pytest.raises(TaskError, match="it takes no seed and no other option"):
+        fresh.reset(seed=1, options={"snapshot": saved})
+    with pytest.raises(TaskError, match="it takes no seed and no other option"):
+        fresh.reset(options={"snapshot": saved, "wind_speed": 8.0})
+    ended = {**saved, "code": np.int64(TETHER_BREAK)}
+    with pytest.raises(TaskError, match=r"the snapshot's episode has ended \(tether_break\)"):
+        fresh.reset(options={"snapshot": ended})
+
+
+def test_a_snapshot_of_an_ended_episode_stays_ended():
+    """Restoring a snapshot taken after a tether break does not reopen step(): the restored
+    env refuses it with ResetNeeded naming the reason, as the env it was taken from does
+    (before 0.7.17 the restore integrated the broken system again). The snapshot of a running
+    episode, restored into the same env after the break, steps on."""
+    env = TetheredAerostatEnv(**{k: v for k, v in EPISODES.items() if k != "max_episode_steps"})
+    env.reset(seed=0)
+    running = env.get_state()
+    for _ in range(2000):
+        *_, terminated, truncated, info = env.step([0.3])
+        if terminated or truncated:
+            break
+    assert info.get("termination") == "tether_break"
+    ended = env.get_state()
+    for snapshot in (ended, ended):
+        env.set_state(snapshot)
+        with pytest.raises(ResetNeeded, match=r"after the episode ended \(tether_break\)"):
+            env.step([0.0])
+    env.set_state(running)
+    assert env.step([0.0])[2] is False  # the running snapshot's first step: no break
+
+
+def test_a_snapshot_without_its_episode_object_is_refused():
+    """A snapshot keeps its Episode (the trim, parameters and wind of its start) through
+    pickle; one whose episode came back from JSON as text is refused at set_state (it was
+    accepted and broke render() and .episode later), leaving the env as it was."""
+    env = TetheredAerostatEnv(**CALM)
+    env.reset(seed=0)
+    saved = env.get_state()
+    env.step([0.1])
+    state = env.state
+    with pytest.raises(ValueError, match="episode is a str, not the Episode from get_state"):
+        env.set_state({**saved, "episode": repr(saved["episode"])})
+    np.testing.assert_array_equal(env.state, state)
+    env.set_state(pickle.loads(pickle.dumps(saved)))
+    np.testing.assert_array_equal(env.state, saved["state"])
 
 
 def test_a_refused_snapshot_leaves_the_env_as_it_was():

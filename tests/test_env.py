@@ -378,8 +378,19 @@ def test_rendering_single_and_vector():
     venv = gym.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point",
                         render_mode="rgb_array")
     venv.reset(seed=0)
-    frame = venv.render()
-    assert frame.shape == (480, 800, 3) and frame.dtype == np.uint8
+    frames = venv.render()  # one per environment, as SyncVectorEnv (env 0's alone before 0.7.17)
+    assert isinstance(frames, tuple) and len(frames) == 2
+    assert all(f.shape == (480, 800, 3) and f.dtype == np.uint8 for f in frames)
+    assert not np.array_equal(frames[0], frames[1])  # two episodes, two pictures
+    single = gym.make(ENV_ID, render_mode="rgb_array")
+    single.reset(seed=1)  # environment 1 of the batch seeded 0
+    assert np.array_equal(frames[1], single.render())
+    sb3 = sb3_vec_env(2, seed=0, render_mode="rgb_array")
+    sb3.reset()
+    images = sb3.get_images()
+    assert len(images) == 2 and np.array_equal(images[1], frames[1])
+    tiled = sb3.render()  # SB3 tiles the frames into one picture
+    assert tiled.shape[0] * tiled.shape[1] == 2 * 480 * 800 and tiled.shape[2] == 3
 
 
 def test_trim_cache_is_bounded(monkeypatch):

@@ -3,10 +3,12 @@ the rule's verdicts on constructed results whose answer is known in closed form,
 on the aggregate, and the validation suite disjoint from the report suite."""
 
 import json
+import math
 
 import numpy as np
 import pytest
 
+from aerostat_gym import jsonout
 from aerostat_gym.agents.evaluate import SUITES, suite_seeds
 from aerostat_gym.agents.protocol import aggregate
 from aerostat_gym.agents.report import load_results
@@ -133,3 +135,22 @@ def test_load_results_names_what_is_wrong(tmp_path):
         load_results([a, a])
     with pytest.raises(ValueError, match=r"\['lqg'\]; labels there: \['passive', 'modal'\]"):
         load_results([a, b], ["lqg"])
+
+
+def test_a_report_json_is_strict_json_and_reads_back_with_its_nans(tmp_path):
+    """report.json writes a metric that is NaN (no lateral swing to fit) as null, which every
+    JSON reader parses (Python's bare NaN token is refused by strict parsers); load_results
+    reads it back as NaN, and the end reason's None stays None."""
+    from aerostat_gym.agents.report import jsonable
+
+    episode = {"wind_speed": 10.0, "seed": 1, "rms_x_m": 2.5, "lateral_pendulum_zeta": math.nan,
+               "ended": None}
+    result = {"label": "passive", "suite": "tiny",
+              "scenarios": {"recover": {"episodes": [episode]}}}
+    path = tmp_path / "report.json"
+    path.write_text(jsonout.dumps(jsonable([result]), indent=1))
+    raw = json.loads(path.read_text(), parse_constant=lambda t: pytest.fail(f"{t} in JSON"))
+    assert raw[0]["scenarios"]["recover"]["episodes"][0]["lateral_pendulum_zeta"] is None
+    back = load_results([path])["passive"]["scenarios"]["recover"]["episodes"][0]
+    assert math.isnan(back["lateral_pendulum_zeta"]) and back["ended"] is None
+    assert back["rms_x_m"] == 2.5 and back["seed"] == 1

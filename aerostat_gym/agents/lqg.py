@@ -372,11 +372,12 @@ class LQGPolicy:
     def _state(self, state, N: int) -> np.ndarray:
         if state is None:
             return np.full((N, self.n + 3), np.nan)
-        S = np.array(state, dtype=float).reshape(N, -1)
-        if S.shape != (N, self.n + 3):
-            raise ValueError(f"LQG state must have shape ({N}, {self.n + 3}), got "
-                             f"{np.shape(state)}")
-        return S
+        S = np.array(state, dtype=float)
+        if S.size != N * (self.n + 3):  # a state of another batch size or another policy
+            raise ValueError(f"LQG state must have shape ({N}, {self.n + 3}) for {N} "
+                             f"observation(s), got {np.shape(state)}: pass back the state "
+                             "that predict returned for this batch")
+        return S.reshape(N, self.n + 3)
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """(actions, state): actions (1,) or (N, 1) float32 in [-1, 1]; state to pass back."""

@@ -367,12 +367,25 @@ def load_results(paths, labels=()) -> dict:
         for r in json.loads(Path(path).read_text()):
             if r["label"] in results:
                 raise ValueError(f"label {r['label']!r} appears twice in {list(map(str, paths))}")
+            for scenario in r["scenarios"].values():
+                scenario["episodes"] = [_nan_for_null(ep) for ep in scenario["episodes"]]
             results[r["label"]] = r
     missing = [lab for lab in labels if lab not in results]
     if missing:
         raise ValueError(f"not in {list(map(str, paths))}: {missing}; labels there: "
                          f"{list(results)}")
     return results
+
+
+#: The fields of an episode record that hold text or None, not a number.
+EPISODE_TEXT_FIELDS = ("ended",)
+
+
+def _nan_for_null(episode: dict) -> dict:
+    """An episode record read back from JSON: a metric that was NaN (no fit, an episode that
+    ended early) is written as null (:mod:`aerostat_gym.jsonout`) and is NaN again here."""
+    return {k: math.nan if v is None and k not in EPISODE_TEXT_FIELDS else v
+            for k, v in episode.items()}
 
 
 def policy_labels(policies: list[str]) -> list[str]:

@@ -25,7 +25,7 @@ from ..sim.events import RUNNING, ground_height
 from . import kernel as K
 from . import reward, spaces
 from .config import TaskConfig, TaskError
-from .episodes import TrimTable, field_length_needed, sample_episode, unit_bank
+from .episodes import Episode, TrimTable, field_length_needed, sample_episode, unit_bank
 
 NO_BANK = np.zeros((1, 1, 0, 3))
 
@@ -285,6 +285,10 @@ class EnvBatch:
         if np.shape(saved["state"]) != self.state[i].shape:
             raise ValueError(f"simulator state has shape {np.shape(saved['state'])}, this "
                              f"environment's is {self.state[i].shape}")
+        if not isinstance(saved["episode"], Episode):
+            raise ValueError(f"simulator state's episode is a {type(saved['episode']).__name__}, "
+                             "not the Episode from get_state() (a snapshot keeps its episode "
+                             "through pickle, not through JSON or YAML)")
         self._check_same_world(saved.get("world"))
         for name in self.SLOT_ARRAYS:
             getattr(self, name)[i] = saved[name]

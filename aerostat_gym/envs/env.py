@@ -12,7 +12,7 @@ from gymnasium.error import ResetNeeded
 from ..sim.events import FAILURES, FIELD_END, OUTCOMES, RUNNING
 from . import reward
 from .batch import EnvBatch
-from .config import TaskConfig
+from .config import TaskConfig, TaskError
 from .render import RENDER_MODES, Frame, Renderer
 
 
@@ -118,7 +118,11 @@ class TetheredAerostatEnv(gym.Env):
     offset, scaled to that episode's mean wind.
     ``reset(options={"wind_speed": U, "perturbation": ...})`` fixes them for one episode (U
     exactly, anywhere in the task's range: off the grid the trim is computed at the reset, a
-    few ms).
+    few ms). ``reset(options={"snapshot": s})`` with ``s`` from :meth:`get_state` (of this env
+    or one made with the same arguments) restores it as :meth:`set_state` does, through the
+    wrappers' reset: the way to restore into an environment made by ``gym.make`` that was
+    never reset (Gymnasium's order check refuses a step after ``env.unwrapped.set_state``
+    there).
 
     ## Episode End
 
@@ -309,7 +313,15 @@ class TetheredAerostatEnv(gym.Env):
       and the baseline's observation space unchanged): on another aerostat the reel-speed
       channel's limit is twice ``winch.max_speed`` (it clipped at 2 m/s on a faster winch) and
       the body rates' 2 rad/s x sqrt(18.3 m / hull length) on a shorter hull; a snapshot's
-      world read back from JSON or YAML is the same world.
+      world read back from JSON or YAML is the same world. ``reset(options={"snapshot": s})``
+      restores a snapshot through the wrappers' reset; ``set_state`` with the snapshot of an
+      ended episode keeps it ended (it reopened ``step``), refuses a snapshot whose episode is
+      not an ``Episode``, and ``get_state`` and ``render`` after ``close`` raise
+      ``ClosedEnvironmentError``. The vector env's ``render()`` returns one frame per
+      environment (environment 0's before); the SB3 adapter's per-environment infos are
+      ``DummyVecEnv``'s at every step (empty but at an episode's end before), its
+      ``get_images`` returns the frames, and it refuses ``env_method`` (which called the whole
+      batch's method once per index) and ``set_attr`` on some environments only.
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}
@@ -335,6 +347,8 @@ class TetheredAerostatEnv(gym.Env):
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         self._batch.check_open("reset()")
+        if isinstance(options, dict) and "snapshot" in options:
+            return self._restore(seed, options)
         super().reset(seed=seed)
         info = self._batch.reset_one(0, self.np_random, options)
         self._batch.add_noise(0, self.np_random)
@@ -342,6 +356,20 @@ class TetheredAerostatEnv(gym.Env):
         if self.render_mode == "human":
             self.render()
         return self._batch.obs[0].copy(), info
+
+    def _restore(self, seed, options: dict):
+        """``reset(options={"snapshot": get_state()})``: :meth:`set_state` through the
+        wrappers' own reset (Gymnasium's order check and environment checker see a reset, the
+        TimeLimit wrapper counts its steps from here); the reset info is the episode's."""
+        saved = options["snapshot"]
+        if seed is not None or len(options) > 1:
+            raise TaskError("the reset option 'snapshot' restores a get_state() snapshot with "
+                            "its own random generator: it takes no seed and no other option")
+        if isinstance(saved, dict) and saved.get("code", RUNNING) != RUNNING:
+            raise TaskError(f"the snapshot's episode has ended ({OUTCOMES[int(saved['code'])]}):"
+                            " there is nothing to step from it; reset() starts a new one")
+        obs = self.set_state(saved)
+        return obs, dict(self.episode.info)
 
     def step(self, action):
         b = self._batch
@@ -379,6 +407,7 @@ class TetheredAerostatEnv(gym.Env):
         return obs, r, terminated, truncated, info
 
     def render(self):
+        self._batch.check_open("render()")
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode="
                             "'rgb_array' or 'human' to gym.make")
@@ -411,6 +440,7 @@ class TetheredAerostatEnv(gym.Env):
         ground, winch and reward settings, observation bounds). Pass it to :meth:`set_state` of
         this environment, or of one made with the same arguments, to return here: the steps
         that follow are bit-identical."""
+        self._batch.check_open("get_state()")
         saved = self._batch.get_slot(0)
         saved["np_random"] = self.np_random.bit_generator.state
         return saved
@@ -420,6 +450,7 @@ class TetheredAerostatEnv(gym.Env):
         snapshot of an environment with another world (see :meth:`get_state`) is refused,
         naming what differs, and leaves this one as it was; one taken on another integration
         step or with the other integrator is accepted (a re-run of the same state)."""
+        self._batch.check_open("set_state()")
         if not isinstance(saved, dict) or "np_random" not in saved:
             raise ValueError("set_state expects a dict from get_state()")
         generator = type(self.np_random.bit_generator)()
@@ -430,7 +461,9 @@ class TetheredAerostatEnv(gym.Env):
                              f"from get_state() ({exc})") from None
         self._batch.set_slot(0, saved)
         self.np_random.bit_generator.state = saved["np_random"]
-        self._ready, self._ended = True, None
+        code = int(self._batch.code[0])  # a snapshot of an ended episode stays ended
+        self._ended = None if code == RUNNING else OUTCOMES[code]
+        self._ready = self._ended is None
         return self._batch.obs[0].copy()
 
     @property

@@ -7,7 +7,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..checks import is_whole
-from .vector import TetheredAerostatVectorEnv
+from .vector import SB3_RESET_PREFIX, TetheredAerostatVectorEnv
 
 
 def check_seed(seed) -> int | None:
@@ -39,9 +39,33 @@ def env_infos(info: dict, num_envs: int, prefix: str = "") -> list[dict]:
     for key, values in info.items():
         if key.startswith("_") or not key.startswith(prefix):
             continue
-        for i in np.flatnonzero(info["_" + key]):
-            out[i][key[len(prefix):]] = values[i]
+        name, mask = key[len(prefix):], info["_" + key]
+        if mask.all() and isinstance(values, np.ndarray):  # every step's keys: one pass
+            for env_info, value in zip(out, values.tolist(), strict=True):
+                env_info[name] = value
+            continue
+        for i in np.flatnonzero(mask):
+            out[i][name] = values[i]
     return out
+
+
+def step_infos(info: dict, terminated: np.ndarray, truncated: np.ndarray) -> list[dict]:
+    """SB3's per-environment step infos from the native batch's SAME_STEP info, as
+    ``DummyVecEnv`` over the single environment has them: every environment's step info (reward
+    terms, time, peak tension, action_clipped, an end's reason) and ``TimeLimit.truncated``;
+    an ended environment's step info is its ended episode's, with ``terminal_observation``."""
+    n = terminated.size
+    running = {k: v for k, v in info.items() if k.lstrip("_") not in ("final_info", "final_obs")}
+    infos = env_infos(running, n)  # the running environments' rows are their step infos
+    done = terminated | truncated
+    if done.any():
+        ended = env_infos(info["final_info"], n)
+        for i in np.flatnonzero(done):
+            infos[i] = ended[i]
+            infos[i]["terminal_observation"] = info["final_obs"][i]
+    for i, env_info in enumerate(infos):
+        env_info["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
+    return infos
 
 
 def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
@@ -60,7 +84,6 @@ def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
 
         def __init__(self):
             self.venv = TetheredAerostatVectorEnv(num_envs, autoreset_mode="SameStep", **kwargs)
-            self.render_mode = None
             super().__init__(num_envs, self.venv.single_observation_space,
                              self.venv.single_action_space)
             self._actions = None
@@ -100,31 +123,43 @@ def sb3_vec_env(num_envs: int, seed: int | None = None, **kwargs):
         def step_wait(self):
             obs, rew, term, trunc, info = self.venv.step(self._actions)
             dones = term | trunc
-            infos = [{} for _ in range(self.num_envs)]
+            infos = step_infos(info, term, trunc)
             if dones.any():
-                started = env_infos(info, self.num_envs, prefix="reset_")
+                started = env_infos(info, self.num_envs, prefix=SB3_RESET_PREFIX)
                 for i in np.flatnonzero(dones):
-                    infos[i]["terminal_observation"] = info["final_obs"][i]
-                    infos[i]["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
-                    for key in ("termination", "failure", "truncation"):
-                        if key in info and info["_" + key][i]:
-                            infos[i][key] = info[key][i]
                     self.reset_infos[i] = started[i]
             return obs, rew.astype(np.float32), dones, infos
+
+        def get_images(self):
+            """One rgb_array frame per environment (``render_mode="rgb_array"``)."""
+            frames = self.venv.render()
+            return [None] * self.num_envs if frames is None else list(frames)
 
         def close(self):
             self.venv.close()
 
         def get_attr(self, attr_name, indices=None):
-            value = getattr(self.venv, attr_name)  # AttributeError naming it, as DummyVecEnv
+            """The batch's attribute, once per index: the environments share one batch and
+            one value (an unknown name is an AttributeError naming it, as DummyVecEnv's)."""
+            value = getattr(self.venv, attr_name)
             return [value for _ in self._get_indices(indices)]
 
         def set_attr(self, attr_name, value, indices=None):
+            """Set an attribute of the shared batch: only for all environments at once."""
+            if sorted(self._get_indices(indices)) != list(range(self.num_envs)):
+                raise ValueError(f"set_attr({attr_name!r}, indices={indices!r}): the "
+                                 "environments of sb3_vec_env share one batch, so an attribute "
+                                 "is set for all of them (indices=None) or none")
             setattr(self.venv, attr_name, value)
 
         def env_method(self, method_name, *args, indices=None, **kw):
-            return [getattr(self.venv, method_name)(*args, **kw)
-                    for _ in self._get_indices(indices)]
+            """Refused: the environments are slots of one compiled batch, with no
+            per-environment object to call a method of (it called the whole batch's once
+            per index before 0.7.17, so env_method("reset", indices=[0]) reset them all)."""
+            raise AttributeError(
+                f"env_method({method_name!r}): sb3_vec_env steps one compiled batch and has no "
+                "per-environment objects; use the VecEnv's own reset, seed and set_options, "
+                "or DummyVecEnv over gym.make(...) for per-environment methods")
 
         def env_is_wrapped(self, wrapper_class, indices=None):
             return [False for _ in self._get_indices(indices)]

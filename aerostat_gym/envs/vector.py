@@ -30,9 +30,10 @@ from .episodes import reset_options
 from .render import Renderer
 
 DEFAULT_MAX_EPISODE_STEPS = 600
-#: SAME_STEP keys kept beside SyncVectorEnv's layout because :mod:`aerostat_gym.envs.sb3` reads
-#: them: the ended slots' reasons at the top level (SyncVectorEnv has them in ``final_info``
-#: only), and their new episodes' reset infos once more with this prefix
+#: SAME_STEP keys beside SyncVectorEnv's layout: the ended slots' reasons at the top level
+#: (SyncVectorEnv has them in ``final_info`` only; kept for the clients that read them there),
+#: and their new episodes' reset infos once more with this prefix, which
+#: :mod:`aerostat_gym.envs.sb3` reads
 SB3_REASONS = ("termination", "failure", "truncation")
 SB3_RESET_PREFIX = "reset_"
 
@@ -89,7 +90,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
         self._steps = np.zeros(num_envs, dtype=np.int64)
         # ended, not stepped: NEXT_STEP resets these at the next step, DISABLED waits for reset()
         self._pending = np.zeros(num_envs, dtype=np.bool_)
-        self._renderer = None
+        self._renderers = {}  # per environment, made at its first frame (see render)
 
     # --- Gymnasium VectorEnv API -----------------------------------------------------------
 
@@ -140,18 +141,27 @@ class TetheredAerostatVectorEnv(VectorEnv):
         return b.obs.copy(), rewards, terminated, truncated, info
 
     def render(self):
-        """An rgb_array frame of environment 0 (None without a render_mode)."""
+        """A tuple of rgb_array frames, one per environment, as Gymnasium's ``SyncVectorEnv``
+        returns them (None without a render_mode). Before 0.7.17: environment 0's frame only."""
+        self.batch.check_open("render()")
         if self.render_mode is None:
             return None
         self.batch.check_started("render()")
-        if self._renderer is None:
-            self._renderer = Renderer(self.batch.params, "rgb_array",
-                                      fps=round(1.0 / self.task.control_step))
-        return self._renderer.render(frame(self.batch.snapshot(0)))
+        return tuple(self._renderer(i).render(frame(self.batch.snapshot(i)))
+                     for i in range(self.num_envs))
+
+    def _renderer(self, i: int) -> Renderer:
+        """Environment i's renderer: one each, as each environment of a SyncVectorEnv has (a
+        renderer keeps its view's limits from frame to frame)."""
+        if i not in self._renderers:
+            self._renderers[i] = Renderer(self.batch.params, "rgb_array",
+                                          fps=round(1.0 / self.task.control_step))
+        return self._renderers[i]
 
     def close_extras(self, **kwargs):
-        if self._renderer is not None:
-            self._renderer.close()
+        for renderer in self._renderers.values():
+            renderer.close()
+        self._renderers = {}
         self.batch.release()
         self._ready = False
 
@@ -193,7 +203,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
     def _same_step_info(self, info: dict, done: np.ndarray) -> dict:
         """SAME_STEP's layout, SyncVectorEnv's: an ended slot's step info moves to
         ``final_info`` (with ``final_obs``) and its new episode's reset info takes its place;
-        plus the :data:`SB3_REASONS` and :data:`SB3_RESET_PREFIX` keys the SB3 adapter reads."""
+        plus the :data:`SB3_REASONS` and :data:`SB3_RESET_PREFIX` keys."""
         final, out = {}, {}
         for key in [k for k in info if not k.startswith("_")]:
             for part, rows in ((final, info["_" + key] & done), (out, info["_" + key] & ~done)):
@@ -220,8 +230,13 @@ class TetheredAerostatVectorEnv(VectorEnv):
 
     def __getstate__(self):
         d = dict(self.__dict__)
-        d["_renderer"] = None
+        d["_renderers"] = {}
         return d
+
+    def __setstate__(self, d):
+        d.pop("_renderer", None)  # pickled before 0.7.17: one renderer for environment 0
+        self.__dict__.update(d)
+        self.__dict__.setdefault("_renderers", {})
 
 
 def _final_obs(obs: np.ndarray, done: np.ndarray) -> np.ndarray:
