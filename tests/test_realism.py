@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from aerostat_gym.agents.intensity import air_inertia_force, realised_intensity
+from aerostat_gym.agents.intensity import air_inertia_force, field_intensity, realised_intensity
 from aerostat_gym.agents.sideslip import yaw_curve
 from aerostat_gym.analysis.trim import find_equilibrium
 from aerostat_gym.params import load_params
@@ -83,24 +83,31 @@ def test_explicit_sigmas_stay_available():
 
 
 def test_realised_intensity_smoke():
-    """Fast version of the slow test below: 'moderate' at 8 m/s, 20 episodes, realised
-    sigma_u / U(h) at the aerostat within 5 % of the 10.05 % target."""
+    """Fast version of the slow test below: 'moderate' at 8 m/s. Over the whole bank (every
+    field read through its period at the trim CM, no sampling spread) sigma_u, sigma_v and
+    sigma_w are the class's to 0.5 % (before 0.7.17 the interpolation between the field's 5 m
+    rows lost 3 / 5 / 8 % of sigma at the aerostat, which sits between rows); 20 episodes of
+    120 s pooled (seeds 100-119) scatter about it: within 10 % (measured +8.6 %; four other
+    sets of 40 episodes at 8 and 12 m/s: -5.3 to +5.4 %)."""
+    whole = field_intensity("moderate", 8.0)
+    assert whole["ratios"] == pytest.approx((1.0, 1.0, 1.0), abs=0.005), whole
     r = realised_intensity("moderate", 8.0, episodes=20)
     assert r["target"] == pytest.approx(0.1005, abs=5e-5)
-    assert r["realised"] == pytest.approx(r["target"], rel=0.05), r
+    assert r["realised"] == pytest.approx(r["target"], rel=0.10), r
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("cls", ["light", "moderate", "severe"])
-@pytest.mark.parametrize("speed, tol", [(4.0, 0.10), (8.0, 0.05), (12.0, 0.05), (16.0, 0.05)])
-def test_realised_intensity_follows_wind(cls, speed, tol):
-    """Realised sigma_u / U(h) at the aerostat, 20 episodes of 120 s pooled (seeds 100-119),
-    against the class's target: measured -8.9 / +1.4 / +3.7 / +4.5 % at 4 / 8 / 12 / 16 m/s,
-    the same for every class (one unit field, scaled). At 4 m/s a 120 s episode reads only
-    480 m of a field with a 305 m integral scale, so 20 episodes do not reach 5 % (other seed
-    sets: +0.8, -10.3, +1.2 %); the 5 % target is met from 8 m/s."""
+@pytest.mark.parametrize("speed", [4.0, 8.0, 12.0, 16.0])
+def test_realised_intensity_follows_wind(cls, speed):
+    """Every class at 4-16 m/s: over the whole bank at the trim CM sigma_u, sigma_v and
+    sigma_w are the class's to 0.5 % (one unit field, scaled to each episode's wind); 20
+    pooled episodes of 120 s scatter about it, by up to 10 % at 4 m/s, where a 120 s episode
+    reads only 480 m of a field with a 305 m integral scale."""
+    whole = field_intensity(cls, speed)
+    assert whole["ratios"] == pytest.approx((1.0, 1.0, 1.0), abs=0.005), whole
     r = realised_intensity(cls, speed, episodes=20)
-    assert r["realised"] == pytest.approx(r["target"], rel=tol), r
+    assert r["realised"] == pytest.approx(r["target"], rel=0.15), r
 
 
 # --- large-angle fins -----------------------------------------------------------------------------

@@ -396,13 +396,13 @@ def test_6_a_break_only_the_coarse_step_sees_is_re_integrated_not_a_failure():
 def test_6_a_snap_of_short_elements_is_re_integrated_not_a_failure():
     """55 m of tether on 24 elements (2.3 m each) at 20 m/s in severe turbulence, random
     reeling (seed 0). At step 90 the 50 ms semi-implicit step snaps a slack element taut: a
-    42.8 kN spike over the 35.6 kN strength where 25 ms down to 1.6 ms agree on 2.45 kN (0.7.5
-    ended the episode there as numerical_divergence). The step is re-integrated: its peak and
-    end positions are those of the same step at 50 / 16 ms to first order (node velocities of
-    the snapping tether differ by up to 1.2 m/s: the scheme damps the snap), and the episode
-    runs on, without a
-    numerical failure, to a ground strike at step 112. The start is the "mixed" preset in
-    metres (10 m swing on 55 m: the episode measured before presets scaled with the tether)."""
+    97.1 kN spike over the 35.6 kN strength where the finer steps agree on 1.01 kN (0.7.5
+    ended such a step as numerical_divergence; with 0.7.16's turbulence sampling the same
+    seed snapped at 42.8 kN against 2.45 kN). The step is re-integrated: its peak is that of
+    the same step at 50 / 16 ms and its end positions are to first order (measured: nodes
+    2.0 cm apart, the aerostat 1.6 mm), and the episode runs on to its 600-step limit
+    without a numerical failure. The start is the "mixed" preset in metres (10 m swing on
+    55 m: the episode measured before presets scaled with the tether)."""
     kw = {"tether_length": 55.0, "n_elements": 24, "wind_speed": 20.0, "turbulence": "severe",
           "perturbation": STRESS_PERTURBATION}
     env = _quiet(gym.make, ENV_ID, overrides={"winch.min_length": 30.0}, **kw)
@@ -417,16 +417,17 @@ def test_6_a_snap_of_short_elements_is_re_integrated_not_a_failure():
             _, _, _, _, reference = fine.step(action)
         _, _, terminated, truncated, info = env.step(action)
         if k == 90:
-            assert info["peak_tension"] == pytest.approx(2454.1, abs=0.1)
+            assert info["peak_tension"] == pytest.approx(1009.3, abs=0.1)
             assert info["peak_tension"] == pytest.approx(reference["peak_tension"], rel=1e-9)
             lay = env.unwrapped._batch.layout
             coarse, finer = env.unwrapped.get_state()["state"], fine.unwrapped.get_state()["state"]
-            # measured: node positions 3.0 cm apart, the aerostat's 2.8 mm
+            # measured: node positions 2.0 cm apart, the aerostat's 1.6 mm
             np.testing.assert_allclose(coarse[lay.node_pos], finer[lay.node_pos], atol=0.05)
             np.testing.assert_allclose(coarse[lay.cm_pos], finer[lay.cm_pos], atol=0.005)
         if terminated or truncated:
             break
-    assert "failure" not in info and (k, info["termination"]) == (112, "ground_strike")
+    assert "failure" not in info and "termination" not in info
+    assert k == len(actions) - 1 and truncated
 
 
 # --- 7. out-of-range winds ---------------------------------------------------------------------

@@ -12,7 +12,16 @@ from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import Params
 from ..physics.core import air_inertia_load, rotation_matrix
 from ..physics.packing import pack_params
-from ..physics.wind import W_DIRC, W_DIRS, air_acceleration, air_velocity, mean_speed
+from ..physics.wind import (
+    W_DIRC,
+    W_DIRS,
+    W_FIELD_DT,
+    W_FIELD_T0,
+    W_TAYLOR_U,
+    air_acceleration,
+    air_velocity,
+    mean_speed,
+)
 from ..wind.presets import resolve_turbulence
 
 SAMPLE_DT = 0.2  # [s] sampling step of the air velocity at the aerostat (the control step)
@@ -63,6 +72,39 @@ def realised_intensity(turbulence, wind_speed: float, episodes: int = 20,
     uh = float(mean_speed(cfg.reference_height, b.wind[0]))
     return {"realised": float(np.sqrt(np.mean(u * u)) / uh), "target": float(np.mean(targets)),
             "speed_at_height": uh, "samples": int(u.size)}
+
+
+def field_intensity(turbulence, wind_speed: float, params: Params | None = None) -> dict:
+    """Realised sigma of u, v, w at the aerostat's trim CM over the whole turbulence bank, as
+    fractions of the class's targets: every bank field read through its full period at the
+    field's own time step (no sampling spread: a pooled set of episodes scatters about these
+    by several per cent, :func:`realised_intensity`). The bank's rows are normalised to unit
+    variance and the sampler keeps it between rows, so each ratio is 1 up to the row
+    correlation's variation with height.
+
+    Returns ``ratios`` (u, v, w), the CM height ``height`` [m] and ``fields`` (bank size)."""
+    env = TetheredAerostatVectorEnv(num_envs=1, turbulence=turbulence, perturbation="none",
+                                    wind_speed=(wind_speed, wind_speed), params=params)
+    env.reset(seed=0)
+    b = env.batch
+    cfg = resolve_turbulence(turbulence)
+    wp = b.wind[0].copy()
+    x, y, z = b.trim_state[0][b.layout.cm_pos]
+    xa = x * wp[W_DIRC] + y * wp[W_DIRS]
+    n_times = b.bank.shape[2]
+    # the field's own samples at this station: t0 + j dt, delayed by the station's xa / U_a
+    times = wp[W_FIELD_T0] + np.arange(n_times) * wp[W_FIELD_DT] + xa / wp[W_TAYLOR_U]
+    squares = np.zeros(3)
+    for wf in b.bank:
+        a = np.array([air_velocity(x, y, z, t, wp, wf) for t in times])
+        along = a[:, 0] * wp[W_DIRC] + a[:, 1] * wp[W_DIRS] - mean_speed(z, wp)
+        across = -a[:, 0] * wp[W_DIRS] + a[:, 1] * wp[W_DIRC]
+        squares += [np.mean(along ** 2), np.mean(across ** 2), np.mean(a[:, 2] ** 2)]
+    targets = np.array(cfg.for_wind(wp).sigmas)
+    fields = b.bank.shape[0]
+    env.close()
+    return {"ratios": tuple(float(r) for r in np.sqrt(squares / fields) / targets),
+            "height": float(z), "fields": int(fields)}
 
 
 def air_inertia_force(params: Params, wp: np.ndarray, wf: np.ndarray, point, duration: float,

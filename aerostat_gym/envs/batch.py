@@ -22,6 +22,7 @@ from ..physics.state import StateLayout, work_size
 from ..physics.wind import W_SIZE, mean_wind, set_advection
 from ..sim import Model
 from ..sim.events import RUNNING, ground_height
+from ..wind.field import pair_decorrelations
 from . import kernel as K
 from . import reward, spaces
 from .config import TaskConfig, TaskError
@@ -153,6 +154,7 @@ class EnvBatch:
     def _bank(self) -> np.ndarray:
         turb = self.task.resolved["turbulence"]
         self._bank_key = None  # what the bank is made from (see world())
+        self._decorrelation = np.zeros((0, 3))  # 1 - rho of its adjacent rows
         if turb.is_off:
             return NO_BANK
         u_max = self.trims.speeds[-1] * _advection_factor(self.params, turb)
@@ -161,6 +163,7 @@ class EnvBatch:
         bank = unit_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
         self._bank_key = (repr(turb.unit()), self.task.wind_bank_size, self.task.wind_bank_seed,
                           bank.shape)
+        self._decorrelation = pair_decorrelations(bank)
         return bank
 
     def release(self) -> None:
@@ -229,7 +232,8 @@ class EnvBatch:
 
     def reset_one(self, i: int, rng: np.random.Generator, options: dict | None = None) -> dict:
         """Start a new episode in slot i; fills obs[i] and returns the episode info."""
-        ep = sample_episode(self.task, self.trims, self.bank.shape, rng, options)
+        ep = sample_episode(self.task, self.trims, self.bank.shape, rng, options,
+                            self._decorrelation)
         self.state[i] = ep.x0
         self.trim_state[i] = ep.x_trim
         self.trim_tension[i] = ep.tension_trim

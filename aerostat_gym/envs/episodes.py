@@ -26,6 +26,7 @@ from ..physics.wind import (
     set_field_scale,
     set_gust,
     set_periodic,
+    set_row_decorrelation,
 )
 from ..sim import Model
 from ..wind.presets import TurbulenceConfig
@@ -245,16 +246,21 @@ def reset_options(options) -> dict:
 
 
 def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.random.Generator,
-                   options: dict | None = None) -> Episode:
+                   options: dict | None = None,
+                   decorrelation: np.ndarray | None = None) -> Episode:
     """Draw one episode start: wind speed, parameters, trim, turbulence offset, perturbation.
 
     ``options`` (from ``reset(options=...)``) may fix ``wind_speed`` (exactly, inside the
     task's range) and ``perturbation`` (a preset name or dict) for this episode.
+    ``decorrelation`` is the bank's, per pair of adjacent rows
+    (:func:`aerostat_gym.wind.field.pair_decorrelations`); the episode takes the pair around
+    its trim's CM, where the aerostat flies.
     """
     opts = reset_options(options)
     unknown = sorted(set(opts) - {"wind_speed", "perturbation"})
     if unknown:
-        raise TaskError(f"unknown reset option(s) {unknown}; known: ['perturbation', 'wind_speed']")
+        raise TaskError(f"unknown reset option(s) {unknown}; known: ['perturbation', 'wind_speed'] "
+                        "(and, on the single environment alone, 'snapshot')")
     pert = (perturbation(opts["perturbation"], trims.params.tether.length,
                          float(trims.speeds[-1]))
             if "perturbation" in opts else task.resolved["perturbation"])
@@ -267,6 +273,10 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
     wp = mean_wind(params.wind, U)
     ua = set_advection(wp, cfg.reference_height, cfg.min_advection_speed)
     field_index, offset = _field(cfg, bank_shape, ua, wp, rng)
+    if decorrelation is not None and decorrelation.shape[0] and not cfg.is_off:
+        height = x_trim[StateLayout(params.tether.n_elements).at(S_Z)]
+        pair = int(min(max((height - cfg.z_min) // cfg.dz, 0), decorrelation.shape[0] - 1))
+        set_row_decorrelation(wp, decorrelation[pair])
     x0, info = _perturb(x_trim, params, pert, wp, ua, rng)
     mix = task.resolved.get("turbulence_mix")
     if mix is not None:  # drawn last: the rest of the episode is the single-class task's

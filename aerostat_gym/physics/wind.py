@@ -71,6 +71,14 @@ W_FIELD_SW = 27
 # 1: the field is periodic in time with its own length (an inverse-FFT synthesis is), and is
 # read modulo that length, so an episode of any length is served; 0: edge values are held
 W_FIELD_PERIODIC = 28
+# 1 - the correlation of adjacent height rows of the field's u, v, w (0: no correction). Linear
+# interpolation between rows whose correlation is rho has variance 1 - 2 a (1 - a) (1 - rho) at
+# the fraction a of the way from one to the next (0.67-0.9 of the rows' at midway for the IEC
+# coherence of 5 m rows); the sampler divides by its square root, so a point between rows has
+# the rows' sigma (set_row_decorrelation)
+W_FIELD_DU = 29
+W_FIELD_DV = 30
+W_FIELD_DW = 31
 W_SIZE = 32
 
 PROFILES = {"uniform": 0, "power": 1, "log": 2}
@@ -194,6 +202,16 @@ def set_field(wp: np.ndarray, z0: float, dz: float, t0: float, dt: float,
     _update_derived(wp)
 
 
+def set_row_decorrelation(wp: np.ndarray, decorrelation) -> None:
+    """Record 1 - rho of adjacent field rows for u, v, w in ``wp`` (in place; see
+    :data:`W_FIELD_DU`): the sampler then keeps the rows' variance between them."""
+    d = tuple(float(v) for v in decorrelation)
+    if len(d) != 3 or not all(math.isfinite(v) and 0.0 <= v < 2.0 for v in d):
+        raise ValueError(f"row decorrelation must be three values 1 - rho in [0, 2), got "
+                         f"{decorrelation!r}")
+    wp[W_FIELD_DU], wp[W_FIELD_DV], wp[W_FIELD_DW] = d
+
+
 def set_periodic(wp: np.ndarray, periodic: bool = True) -> None:
     """Read the field modulo its length (in place): for fields synthesised by an inverse FFT,
     which are exactly periodic, so the wrap is seamless (sample n equals sample 0)."""
@@ -253,7 +271,8 @@ def _periodic_index(f, n):
 
 @njit(**_JIT, inline="always")
 def _field_sample(xa, z, t, wp, wf):
-    """Bilinear interpolation of the field at height z and Taylor-delayed time t - xa / U_a.
+    """Bilinear interpolation of the field at height z and Taylor-delayed time t - xa / U_a,
+    rescaled in height to the rows' variance (:data:`W_FIELD_DU`).
 
     Outside the height grid the nearest edge value is held (heights above the top row read the
     top row). In time, a periodic field (``W_FIELD_PERIODIC``) is read modulo its length;
@@ -274,9 +293,14 @@ def _field_sample(xa, z, t, wp, wf):
     w01 = (1.0 - az) * at
     w10 = az * (1.0 - at)
     w11 = az * at
-    return (w00 * wf[kz, kt, 0] + w01 * wf[kz, kt1, 0] + w10 * wf[kz1, kt, 0] + w11 * wf[kz1, kt1, 0],
-            w00 * wf[kz, kt, 1] + w01 * wf[kz, kt1, 1] + w10 * wf[kz1, kt, 1] + w11 * wf[kz1, kt1, 1],
-            w00 * wf[kz, kt, 2] + w01 * wf[kz, kt1, 2] + w10 * wf[kz1, kt, 2] + w11 * wf[kz1, kt1, 2])
+    # the interpolation's variance loss between partly correlated rows, restored (W_FIELD_DU)
+    g = 2.0 * az * (1.0 - az)
+    return ((w00 * wf[kz, kt, 0] + w01 * wf[kz, kt1, 0] + w10 * wf[kz1, kt, 0]
+             + w11 * wf[kz1, kt1, 0]) / math.sqrt(1.0 - g * wp[W_FIELD_DU]),
+            (w00 * wf[kz, kt, 1] + w01 * wf[kz, kt1, 1] + w10 * wf[kz1, kt, 1]
+             + w11 * wf[kz1, kt1, 1]) / math.sqrt(1.0 - g * wp[W_FIELD_DV]),
+            (w00 * wf[kz, kt, 2] + w01 * wf[kz, kt1, 2] + w10 * wf[kz1, kt, 2]
+             + w11 * wf[kz1, kt1, 2]) / math.sqrt(1.0 - g * wp[W_FIELD_DW]))
 
 
 @njit(**_JIT, inline="always")

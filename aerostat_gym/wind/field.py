@@ -29,6 +29,7 @@ from ..physics.wind import (
     set_advection,
     set_field,
     set_gust,
+    set_row_decorrelation,
 )
 from .dryden import dryden_point_field
 from .presets import TurbulenceConfig, resolve_turbulence
@@ -109,7 +110,34 @@ def _add_field(wp: np.ndarray, cfg: TurbulenceConfig, ua: float, duration: float
         wf = veers_field(cfg, ua, n, rng)
         z0 = cfg.z_min
     set_field(wp, z0, cfg.dz, t0, cfg.dt, cfg.downwind_extent, cfg.upwind_extent)
+    set_row_decorrelation(wp, row_decorrelation(wf, z0, cfg.dz, cfg.reference_height))
     return wf
+
+
+def row_decorrelation(fields: np.ndarray, z0: float, dz: float, height: float) -> tuple:
+    """1 - the correlation of the two field rows around ``height`` [m], for u, v, w: what the
+    sampler needs to keep the rows' variance between them (:data:`W_FIELD_DU`). ``fields`` is
+    one field (rows, times, 3) or a bank of them (fields, rows, times, 3); rows from ``z0`` [m]
+    every ``dz`` [m]. A single row (a point field) needs no correction: zeros."""
+    pairs = pair_decorrelations(fields)
+    if pairs.shape[0] == 0:
+        return (0.0, 0.0, 0.0)
+    k = int(min(max(math.floor((height - z0) / dz), 0), pairs.shape[0] - 1))
+    return tuple(float(v) for v in pairs[k])
+
+
+def pair_decorrelations(fields: np.ndarray) -> np.ndarray:
+    """1 - rho of every pair of adjacent rows (rows - 1, 3) of a field or a bank of fields
+    (see :func:`row_decorrelation`), clipped to [0, 1]."""
+    bank = fields if fields.ndim == 4 else fields[None]
+    if bank.shape[1] < 2 or bank.shape[2] == 0:
+        return np.zeros((0, 3))
+    lower, upper = bank[:, :-1], bank[:, 1:]
+    cross = np.einsum("nktc,nktc->kc", lower, upper)
+    power = np.einsum("nktc,nktc->kc", bank, bank)
+    norm = np.sqrt(power[:-1] * power[1:])
+    rho = np.divide(cross, norm, out=np.ones_like(cross), where=norm > 0.0)
+    return np.clip(1.0 - rho, 0.0, 1.0)
 
 
 def mean_vector(mean) -> np.ndarray:
