@@ -18,7 +18,12 @@ __version__ = "0.7.17"
 #: (``randomize``, as in ``TetheredAerostatRealistic-v0``) draws again the moments of inertia
 #: no body has, about 11 % of the starts. A start seeded by reset(seed=...) whose first draw
 #: is a body is bit-identical; in a stream of unseeded resets (training) the redraws shift the
-#: generator, so every episode after the first redraw differs.
+#: generator, so every episode after the first redraw differs. 0.7.17 changes the wind of the
+#: turbulent tasks: the aerostat, flying between the turbulence field's height rows, feels the
+#: class's full sigma (3 / 5 / 8 % more in u / v / w than before, which the interpolation between
+#: rows lost); calm-air episodes are bit-identical, turbulent ones differ, and a policy trained
+#: before (the shipped one, on the light turbulence of TetheredAerostatRealistic-v0) runs in the
+#: turbulence its class states, a few per cent stronger than the one it was trained in.
 TASKS_COMPATIBLE_SINCE = "0.4.0"
 
 register()

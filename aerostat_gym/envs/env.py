@@ -309,8 +309,11 @@ class TetheredAerostatEnv(gym.Env):
       length with the same element count ran on with this env's reward band). Arguments
       that resolve alike are the same world; another integration step or integrator is
       allowed (a re-run); snapshots of 0.7.15 and before are taken on trust.
-    - v0 (aerostat-gym 0.7.17; dynamics, reward, the registered tasks, their seeded episodes
-      and the baseline's observation space unchanged): on another aerostat the reel-speed
+    - v0 (aerostat-gym 0.7.17; reward, calm-air dynamics and episodes and the baseline's
+      observation space unchanged): the turbulence has its class's sigma between the field's
+      height rows, where the aerostat flies (the linear interpolation between partly
+      correlated rows lost 3 / 5 / 8 % of sigma in u / v / w there), so turbulent episodes
+      differ from 0.7.16's. On another aerostat the reel-speed
       channel's limit is twice ``winch.max_speed`` (it clipped at 2 m/s on a faster winch) and
       the body rates' 2 rad/s x sqrt(18.3 m / hull length) on a shorter hull; a snapshot's
       world read back from JSON or YAML is the same world. ``reset(options={"snapshot": s})``
