@@ -73,7 +73,8 @@ def test_sweep_rows_are_the_evaluators_episodes_smoke():
 def test_sweep_reproduces_the_report_suite():
     """The default modal design in light turbulence at 8 m/s over the 20 report seeds: mean RMS
     along-wind displacement and its ratio to the braked winch's equal the stored protocol's
-    (1.591 m, 0.929) within 1e-9 relative: the sweep runs the report's own episodes."""
+    (1.658 m, 0.931 with 0.7.17's turbulence; 1.591 m, 0.929 before) within 1e-9 relative: the
+    sweep runs the report's own episodes."""
     sweep = authority_sweep(load_params(), designs=(Design("modal", "modal"),),
                             scenarios=("gusty_light",), report_speeds=(8.0,))
     (row,) = sweep["gusty"]
@@ -81,11 +82,11 @@ def test_sweep_reproduces_the_report_suite():
     passive = _stored("gusty_light", 8.0, "passive", "rms_x_m")
     assert row["rms_x_m"] == pytest.approx(modal, rel=1e-9)
     assert row["rms_x_ratio"] == pytest.approx(modal / passive, rel=1e-9)
-    # 0.929 x passive misses the 0.8 target with a paired interval above zero
+    # 0.931 x passive misses the 0.8 target with a paired interval above zero
     assert row["targets"]["rms_x_m"]["verdict"] == "missed"
     cell = reachable(sweep)[0]
     assert cell["best_design"] == "modal" and cell["all_targets"] == []
-    assert "| gusty_light | modal | 0.929 | **no** |" in gust_markdown(sweep, 8.0)
+    assert "| gusty_light | modal | 0.931 | **no** |" in gust_markdown(sweep, 8.0)
     (rec10,) = [r for r in sweep["recover"] if r["wind_speed"] == 10.0]
     assert rec10["pendulum_zeta"] == pytest.approx(_stored("recover", 10.0, "modal",
                                                            "pendulum_zeta"), rel=1e-9)

@@ -782,6 +782,22 @@ def test_memory_returns_after_closing_vector_envs():
     assert m["delta_mb"] < 100.0
 
 
+def test_9_a_script_whose_main_returns_its_results_exits_0():
+    """authority_sweep.py and four other scripts return their results from main (for the tests
+    and the studies that import them): run_script exits 0 for them (it raised a TypeError
+    traceback from int(dict) after the work was done), an int is the exit status, and a
+    refused input is status 2."""
+    from aerostat_gym.cli.common import run_script
+
+    assert run_script(lambda: {"rows": [1, 2]}) == 0
+    assert run_script(lambda: None) == 0
+    assert run_script(lambda: 3) == 3
+
+    def refused():
+        raise ValueError("bad input")
+    assert run_script(refused) == 2
+
+
 @pytest.mark.parametrize("script, argv, text", [
     ("reproduce_figure8.py", ["--config", "TYPO", "--out", "OUT"], "unknown section(s): x"),
     ("task_returns.py", ["--policy", "nosuch"], "unknown policy 'nosuch'"),

@@ -173,9 +173,11 @@ def script_description(doc: str) -> str:
 def run_script(main) -> int:
     """Run a script's ``main()`` as the CLI runs a command: a refused input (a ParameterError,
     a PolicyError or another ValueError, a file that cannot be read) is one line on stderr and
-    exit status 2, not a traceback."""
+    exit status 2, not a traceback. A ``main`` that returns its results (a dict, for the tests
+    and the studies that import it) exits 0; one that returns an int exits with it."""
     try:
-        return int(main() or 0)
+        result = main()
+        return result if isinstance(result, int) else 0
     except (ValueError, RuntimeError, OSError) as exc:
         print(f"{Path(sys.argv[0]).name}: error: {exc}", file=sys.stderr)
         return 2
