@@ -75,6 +75,7 @@ from aerostat_gym.params import (
     advised_semi_implicit_dt,
     dumps_toml,
     load_params,
+    paid_out_weight,
     parameter_table,
     params_from_dict,
     tether_drag_step,
@@ -697,6 +698,22 @@ def test_families_and_sensitivity_ranges_follow_the_configuration():
     lengths = family_values(odd, "tether.length")
     assert lengths[0] == 160.00000000012345 and lengths[1:] == (225.0, 300.0, 375.0)
     assert odd.replace(**{"tether.length": lengths[0]}).tether.length == lengths[0]
+    # a heavy line (16 mm, 3800 kg/m^3: 300 m weigh 0.85 of the net lift) can be lifted to
+    # 353 m only: the 375 m member, which loading refuses, is left out (it stopped
+    # reproduce_figure9.py with that refusal before 0.7.17)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the heavy line's load warning
+        heavy = load_params(overrides={"tether.diameter": 0.016, "tether.density": 3800.0})
+    reach = heavy.derived.net_lift / paid_out_weight(heavy, 1.0)
+    assert 350.0 < reach < 356.0
+    assert family_values(heavy, "tether.length") == (150.0, 225.0, 300.0)
+    # a slender hull's k3 of 0.96 and an eta_k of 0.9: the ranges end at 1, the coefficients'
+    # bound (x1.07 and x1.25 gave 1.03 and 1.125, studied as INVALID before 0.7.17)
+    slender = {k.key: k for k in default_knobs(load_params(
+        overrides={"aerostat.k3": 0.96, "hull.eta_k": 0.9}))}
+    assert (slender["aerostat.k3"].low, slender["aerostat.k3"].high) == pytest.approx(
+        (0.96 * 0.584 / 0.7494, 1.0))
+    assert (slender["hull.eta_k"].low, slender["hull.eta_k"].high) == pytest.approx((0.225, 1.0))
     knobs = {k.key: k for k in default_knobs(load_params())}
     for key, (lo, hi) in {"fins.planform_area": (12.0, 25.0), "cm_x_shift": (-0.3, 0.3),
                           "hull.eta_k": (0.1, 0.5), "fins.CL_alpha": (1.2, 2.5),

@@ -91,6 +91,7 @@ def test_real_aerostats_from_5_to_70_m_load_without_warnings(tmp_path, name):
     {"hull.Cdc": 0.3}, {"aerostat.leash_z": -18.3},
     {"simulation.rk4_safety": RK4_SAFETY_LIMIT},
     {"wind.speed": MAX_WIND_SPEED}, {"tether.anchor_position": [0.0, 0.0, 120.0]},
+    {"tether.length": 201.0}, {"tether.length": 400.0},  # within a factor 1.5 of the 300 m
 ])
 def test_real_variants_load_without_warnings(over):
     _load_quietly(overrides=over)
@@ -115,6 +116,12 @@ REFUSED = [
      ("tether.youngs_modulus = 37400 Pa", "looks like MPa written as Pa")),
     (BASE, "tether", "youngs_modulus", 37.4e15, ImplausibleParameterError,
      ("tether.youngs_modulus", "stiffer than diamond")),
+    # a 1 mm line left with the 6 mm line's 35.6 kN strength: the modulus is right (no unit
+    # slip to suggest; 0.7.16 suggested "MPa written as Pa", which is then stiffer than
+    # diamond), the strength does not fit the diameter: 25 % strain at 7343 N
+    (BASE, "tether", "diameter", 0.001, ImplausibleParameterError,
+     ("tether.youngs_modulus = 3.74e+10 Pa gives EA = 2.937e+04 N on the 1 mm tether",
+      "tether.strength does not fit tether.diameter: this line would stretch 25 % at 7343 N")),
     (BASE, "tether", "density", 0.975, ImplausibleParameterError,
      ("tether.density = 0.975", "looks like g/cm^3 written as kg/m^3")),
     (BASE, "aerostat", "diameter", 770.0, ImplausibleParameterError,
@@ -250,6 +257,10 @@ def test_rk4_limit_matches_the_integrators_measured_edge():
     ({"aerostat.volume": 300.0, "aerostat.mass": 120.0}, "aerostat.volume = 300"),
     # 72.5 N of net lift carries 311 m of the 0.233 N/m line: 400 m (93.2 N) may be paid out
     ({"aerostat.mass": 587.9}, "winch.max_length = 400 m of tether (93.2 N): paid out past 311 m"),
+    # the tether shortened without the turbulence's height (300 m, the baseline's tether): the
+    # aerostat would fly in 300 m turbulence at 150 m (the warning is new in 0.7.17)
+    ({"tether.length": 150.0}, "wind.turbulence_reference_height = 300 m is far from the "
+                               "aerostat's height (tether.length = 150 m)"),
 ])
 def test_unusual_values_warn(over, field):
     with pytest.warns(ParameterWarning, match=re.escape(field)):

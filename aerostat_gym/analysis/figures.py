@@ -16,7 +16,7 @@ from scipy.linalg import expm
 
 from .. import jsonout
 from ..extras import agg_pyplot
-from ..params import Params, load_params
+from ..params import Params, load_params, paid_out_weight
 from ..sim import Model, simulate
 from .linear import linearize, propagate
 from .modes import FIGURE9_MODES, SETS, Sweep, wind_sweep
@@ -461,13 +461,15 @@ FAMILIES = {
 
 def family_values(params: Params, name: str) -> tuple[float, ...]:
     """The values of one family for ``params``: scaled or offset from the configured value;
-    lengths are kept inside the winch's limits (a length outside them is refused on loading)."""
+    lengths are kept inside the winch's limits (a length outside them is refused on loading),
+    and a length whose tether outweighs the net lift (also refused on loading) is left out."""
     kind, steps = FAMILIES[name]
     sec, key = name.split(".")
     base = float(getattr(getattr(params, sec), key))
     values = [base * v for v in steps] if kind == "scale" else [base + v for v in steps]
     if name == "tether.length":
         values = [min(max(v, params.winch.min_length), params.winch.max_length) for v in values]
+        values = [v for v in values if paid_out_weight(params, v) < params.derived.net_lift]
     # one value per distinct (rounded) length; the value itself unrounded, so a length clamped
     # to a winch limit stays on it
     distinct = {}

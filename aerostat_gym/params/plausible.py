@@ -48,6 +48,8 @@ SEMI_IMPLICIT_REFUSE_FACTOR = 2.0
 #: 12-15 %); nylon, the stretchiest rope fibre, at 20-40 %. Above WARN: unusual (a nylon-like
 #: line); above MAX: no rope stretches to twice its length before breaking.
 TETHER_BREAK_STRAIN_WARN = 0.25
+#: wind.turbulence_reference_height more than this factor from tether.length warns at load
+TURBULENCE_HEIGHT_WARN = 1.5
 TETHER_BREAK_STRAIN_MAX = 1.0
 #: Strain of the tether under the still-air net lift, net lift / EA: a tether is loaded at a
 #: fraction of its strength, so a real one stretches well under 10 %; a modulus so low that
@@ -150,17 +152,23 @@ def _plausible_tether(p: Params) -> None:
             "diamond" + slip_hint(E, {"kPa written as Pa": 1e-3, "MPa written as Pa": 1e-6},
                               lambda v: v <= TETHER_MODULUS_MAX))
     if break_strain > TETHER_BREAK_STRAIN_MAX or lift_strain > TETHER_LIFT_STRAIN_MAX:
-        ok = lambda v: (safe_ratio(t.strength, v * d.tether_area) <= TETHER_BREAK_STRAIN_WARN  # noqa: E731
+        ok = lambda v: (v <= TETHER_MODULUS_MAX  # noqa: E731
+                        and safe_ratio(t.strength, v * d.tether_area) <= TETHER_BREAK_STRAIN_WARN
                         and safe_ratio(d.net_lift, v * d.tether_area) <= TETHER_LIFT_STRAIN_MAX)
+        hint = slip_hint(E, {"MPa written as Pa": 1e6, "GPa written as Pa": 1e9,
+                             "GPa written as MPa": 1e3}, ok)
+        if not hint and lift_strain <= TETHER_LIFT_STRAIN_MAX:
+            # the modulus holds the net lift: the strength does not belong to this line
+            hint = (f"; if the modulus is right, tether.strength does not fit tether.diameter: "
+                    f"this line would stretch {100 * TETHER_BREAK_STRAIN_WARN:g} % at "
+                    f"{TETHER_BREAK_STRAIN_WARN * d.EA:.4g} N")
         raise ImplausibleParameterError(
             f"tether.youngs_modulus = {E:g} Pa gives EA = {d.EA:.4g} N on the "
             f"{1000 * t.diameter:g} mm tether (tether.diameter): it would stretch by "
             f"{100 * lift_strain:.3g} % under the net lift ({d.net_lift:.1f} N) and by "
             f"{100 * break_strain:.3g} % at tether.strength ({t.strength:g} N); a real tether "
             f"stretches a few % at break (bounds: {100 * TETHER_LIFT_STRAIN_MAX:g} % under the "
-            f"net lift, {100 * TETHER_BREAK_STRAIN_MAX:g} % at break)"
-            + slip_hint(E, {"MPa written as Pa": 1e6, "GPa written as Pa": 1e9,
-                        "GPa written as MPa": 1e3}, ok))
+            f"net lift, {100 * TETHER_BREAK_STRAIN_MAX:g} % at break)" + hint)
     rho_t = t.density
     lo, hi = TETHER_DENSITY_MAX
     if not lo <= rho_t <= hi:
@@ -307,6 +315,13 @@ def plausibility_warnings(p: Params) -> list[str]:
     if p.hull.Cdc > HULL_CDC_WARN:
         out.append(f"hull.Cdc = {p.hull.Cdc:g} is above a circular cylinder's 0.3-1.2 "
                    f"(warning above {HULL_CDC_WARN:g})")
+    ref, length = p.wind.turbulence_reference_height, t.length
+    if not length / TURBULENCE_HEIGHT_WARN <= ref <= length * TURBULENCE_HEIGHT_WARN:
+        out.append(f"wind.turbulence_reference_height = {ref:g} m is far from the aerostat's "
+                   f"height (tether.length = {length:g} m): the turbulence's intensity, length "
+                   f"scales and advection are those at {ref:g} m; set it near the height the "
+                   "aerostat flies at (the shipped files and scale_aerostat use the tether "
+                   f"length; warning outside a factor {TURBULENCE_HEIGHT_WARN:g} of it)")
     full = paid_out_weight(p, p.winch.max_length)
     if d.net_lift <= full:
         reach = d.net_lift / paid_out_weight(p, 1.0)
