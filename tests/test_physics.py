@@ -114,7 +114,8 @@ def _periods(length, n=10, integrator="rk4"):
     # the winch's limits widened so that every length tested lies inside them
     top = max(400.0, length)
     p = load_params(overrides={"tether.length": length, "tether.n_elements": n,
-                               "winch.max_length": top, "winch.total_line_length": top})
+                               "winch.max_length": top, "winch.total_line_length": top,
+                               "wind.turbulence_reference_height": length})  # still air
     eq = find_equilibrium(p, 0.0)
     lay = Model(p).layout
     x = eq.x.copy()

@@ -29,6 +29,7 @@ from ..physics.wind import (
     set_row_decorrelation,
 )
 from ..sim import Model
+from ..wind.field import decorrelation_at
 from ..wind.presets import TurbulenceConfig
 from ..wind.synthesis import check_field_size, fft_length, veers_field
 from .config import TaskConfig, TaskError, get_parameter, perturbation
@@ -273,10 +274,9 @@ def sample_episode(task: TaskConfig, trims: TrimTable, bank_shape, rng: np.rando
     wp = mean_wind(params.wind, U)
     ua = set_advection(wp, cfg.reference_height, cfg.min_advection_speed)
     field_index, offset = _field(cfg, bank_shape, ua, wp, rng)
-    if decorrelation is not None and decorrelation.shape[0] and not cfg.is_off:
+    if decorrelation is not None and not cfg.is_off:
         height = x_trim[StateLayout(params.tether.n_elements).at(S_Z)]
-        pair = int(min(max((height - cfg.z_min) // cfg.dz, 0), decorrelation.shape[0] - 1))
-        set_row_decorrelation(wp, decorrelation[pair])
+        set_row_decorrelation(wp, decorrelation_at(decorrelation, cfg.z_min, cfg.dz, height))
     x0, info = _perturb(x_trim, params, pert, wp, ua, rng)
     mix = task.resolved.get("turbulence_mix")
     if mix is not None:  # drawn last: the rest of the episode is the single-class task's

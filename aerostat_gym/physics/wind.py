@@ -73,9 +73,9 @@ W_FIELD_SW = 27
 W_FIELD_PERIODIC = 28
 # 1 - the correlation of adjacent height rows of the field's u, v, w (0: no correction). Linear
 # interpolation between rows whose correlation is rho has variance 1 - 2 a (1 - a) (1 - rho) at
-# the fraction a of the way from one to the next (0.67-0.9 of the rows' at midway for the IEC
-# coherence of 5 m rows); the sampler divides by its square root, so a point between rows has
-# the rows' sigma (set_row_decorrelation)
+# the fraction a of the way from one to the next (rho 0.67-0.9 for the IEC coherence of 5 m
+# rows: 0.83-0.95 of the rows' variance midway); the sampler divides by its square root, so a
+# point between rows has the rows' sigma (set_row_decorrelation)
 W_FIELD_DU = 29
 W_FIELD_DV = 30
 W_FIELD_DW = 31

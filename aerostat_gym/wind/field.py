@@ -119,7 +119,12 @@ def row_decorrelation(fields: np.ndarray, z0: float, dz: float, height: float) -
     sampler needs to keep the rows' variance between them (:data:`W_FIELD_DU`). ``fields`` is
     one field (rows, times, 3) or a bank of them (fields, rows, times, 3); rows from ``z0`` [m]
     every ``dz`` [m]. A single row (a point field) needs no correction: zeros."""
-    pairs = pair_decorrelations(fields)
+    return decorrelation_at(pair_decorrelations(fields), z0, dz, height)
+
+
+def decorrelation_at(pairs: np.ndarray, z0: float, dz: float, height: float) -> tuple:
+    """The row pair around ``height`` [m] of :func:`pair_decorrelations`' ``pairs`` (rows from
+    ``z0`` every ``dz`` [m]; the edge pair beyond the grid), as (u, v, w); zeros for none."""
     if pairs.shape[0] == 0:
         return (0.0, 0.0, 0.0)
     k = int(min(max(math.floor((height - z0) / dz), 0), pairs.shape[0] - 1))
