@@ -50,7 +50,12 @@ from aerostat_gym.analysis.reference import (
     table2,
     veering_allowance,
 )
-from aerostat_gym.analysis.sensitivity import default_knobs
+from aerostat_gym.analysis.sensitivity import (
+    default_knobs,
+    format_sensitivity,
+    select_knobs,
+    sensitivity_table,
+)
 from aerostat_gym.analysis.trim import TrimError, find_equilibrium
 from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main
@@ -830,6 +835,19 @@ def test_reel_speed_and_body_rate_limits_follow_the_winch_and_the_hull():
     for rate in ("p", "q", "r"):
         assert base_hi[OBS_INDEX[rate]] * CHANNELS[OBS_INDEX[rate]].scale == pytest.approx(2.0)
         assert hi[OBS_INDEX[rate]] == pytest.approx(2.0 * base_hi[OBS_INDEX[rate]], rel=1e-3)
+
+
+def test_sensitivity_table_columns_stay_aligned_for_a_large_aerostat():
+    """30 x the baseline's volume: its product of inertia's range, -8.689e+04 to +8.689e+04
+    kg m^2, 20 characters, widens the 17-column range cell instead of shifting its row's
+    period columns (before 0.7.17 they stood 3 columns right of the other rows')."""
+    p = scale_aerostat(load_params(), volume_factor=30.0, tether_length=900.0, n_elements=6)
+    knobs = select_knobs(default_knobs(p), ["aerostat.Ixz", "hull.eta_k"])
+    text = format_sensitivity(sensitivity_table(p, knobs, (5.0,)))
+    rows = [line for line in text.splitlines() if line.startswith(("product", "hull eff"))]
+    assert len(rows) == 2 and "-8.689e+04-8.689e+04" in rows[1]
+    slashes = [[i for i, c in enumerate(row) if c == "/"] for row in rows]
+    assert len(slashes[0]) == 5 and slashes[0] == slashes[1]
 
 
 def test_schedules_stop_where_the_winch_motor_cannot_hold_the_trim():

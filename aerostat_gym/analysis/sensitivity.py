@@ -266,20 +266,23 @@ def format_sensitivity(table: dict) -> str:
     short = {"long_pendulum": "long.pend", "lat_pendulum": "lat.pend", "axial_spring": "axial",
              "tether_1st": "tether1"}
     b = table["baseline"]
-    head = (f"{'parameter':32s} {'range':>17s} " + " ".join(f"{short[k]:>13s}" for k in PERIOD_KEYS)
-            + f" {'min zeta':>13s}")
+    # a range wider than its 17 columns (a large aerostat's inertias) widens the column
+    ranges = [f"{r['low']:8.4g}-{r['high']:<8.4g}" for r in table["rows"]]
+    width = max([17] + [len(x) for x in ranges])
+    head = (f"{'parameter':32s} {'range':>{width}s} "
+            + " ".join(f"{short[k]:>13s}" for k in PERIOD_KEYS) + f" {'min zeta':>13s}")
     lines = ["baseline: " + ", ".join(f"{short[k]} {b[k]:.3f} s" for k in PERIOD_KEYS)
              + f", min zeta {b['min_zeta']:.3f} ({b['min_zeta_at']['set']} {b['min_zeta_at']['mode']}"
              f" at {b['min_zeta_at']['wind_speed_m_s']:g} m/s)", "% change of each period at the low / high end of the range",
              head, "-" * len(head)]
-    for r in table["rows"]:
+    for r, span in zip(table["rows"], ranges, strict=True):
         cells = []
         for k in PERIOD_KEYS:
             lo, hi = r.get("low_pct", {}).get(k, math.nan), r.get("high_pct", {}).get(k, math.nan)
             cells.append(f"{_signed(lo)}/{_signed(hi)}")
         ends = (r["low_result"], r["high_result"])
         zl, zh = (_plain(e.get("min_zeta", math.nan)) for e in ends)
-        lines.append(f"{r['label']:32s} {r['low']:8.4g}-{r['high']:<8.4g} " + " ".join(f"{c:>13s}" for c in cells)
+        lines.append(f"{r['label']:32s} {span:<{width}s} " + " ".join(f"{c:>13s}" for c in cells)
                      + f" {zl}/{zh}{_verdict(ends)}")
     if any("n/a" in line for line in lines):
         lines.append("n/a: no trim at that end (--json has the error), the mode overdamped there "
