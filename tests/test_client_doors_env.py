@@ -571,7 +571,7 @@ def test_a_snapshot_of_an_ended_episode_stays_ended():
             break
     assert info.get("termination") == "tether_break"
     ended = env.get_state()
-    for snapshot in (ended, ended):
+    for snapshot in (ended, pickle.loads(pickle.dumps(ended))):
         env.set_state(snapshot)
         with pytest.raises(ResetNeeded, match=r"after the episode ended \(tether_break\)"):
             env.step([0.0])

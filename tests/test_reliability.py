@@ -27,6 +27,7 @@ from aerostat_gym.envs import ActionError, TaskError, TetheredAerostatEnv, episo
 from aerostat_gym.envs import config as config_module
 from aerostat_gym.envs.vector import TetheredAerostatVectorEnv
 from aerostat_gym.params import ParameterError, load_params
+from aerostat_gym.physics.packing import P_STRENGTH
 from aerostat_gym.physics.wind import NO_FIELD, W_FIELD_T0, air_velocity, pack_wind, set_field
 from aerostat_gym.sim import Model
 
@@ -408,13 +409,22 @@ def test_6_a_snap_of_short_elements_is_re_integrated_not_a_failure():
     env = _quiet(gym.make, ENV_ID, overrides={"winch.min_length": 30.0}, **kw)
     fine = _quiet(gym.make, ENV_ID, overrides={"winch.min_length": 30.0,
                                                "simulation.semi_implicit_dt": 0.05 / 16}, **kw)
+    probe = _quiet(gym.make, ENV_ID, overrides={"winch.min_length": 30.0}, **kw)
     env.reset(seed=0)
     fine.reset(seed=0)
+    probe.reset(seed=0)
     actions = np.random.default_rng(0).uniform(-1, 1, (600, 1)).astype(np.float32)
     for k, action in enumerate(actions):
         if k == 90:
-            fine.unwrapped.set_state(env.unwrapped.get_state())
+            saved = env.unwrapped.get_state()
+            fine.unwrapped.set_state(saved)
             _, _, _, _, reference = fine.step(action)
+            # the snap itself: the same 50 ms step without a break to re-integrate (strength
+            # out of reach) peaks far above the 35.6 kN strength
+            unbreakable = {**saved, "packed": saved["packed"].copy()}
+            unbreakable["packed"][P_STRENGTH] = 1e12
+            probe.unwrapped.set_state(unbreakable)
+            assert probe.step(action)[4]["peak_tension"] == pytest.approx(97067.4, abs=0.5)
         _, _, terminated, truncated, info = env.step(action)
         if k == 90:
             assert info["peak_tension"] == pytest.approx(1009.3, abs=0.1)

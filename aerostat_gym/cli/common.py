@@ -177,7 +177,7 @@ def run_script(main) -> int:
     and the studies that import it) exits 0; one that returns an int exits with it."""
     try:
         result = main()
-        return result if isinstance(result, int) else 0
+        return result if isinstance(result, int) and not isinstance(result, bool) else 0
     except (ValueError, RuntimeError, OSError) as exc:
         print(f"{Path(sys.argv[0]).name}: error: {exc}", file=sys.stderr)
         return 2

@@ -441,8 +441,9 @@ def _advection_factor(params, turb) -> float:
 
 
 def _as_lists(value):
-    """``value`` with every tuple a list, recursively: a snapshot's world compares equal after
-    a trip through JSON or YAML (which write tuples as lists)."""
+    """``value`` with every tuple a list, recursively: a snapshot's ``world`` entry compares
+    equal after a trip through JSON or YAML (which write tuples as lists; the snapshot as a
+    whole goes through pickle, its episode has no JSON form)."""
     if isinstance(value, (tuple, list)):
         return [_as_lists(v) for v in value]
     return value

@@ -41,7 +41,7 @@ def env_infos(info: dict, num_envs: int, prefix: str = "") -> list[dict]:
             continue
         name, mask = key[len(prefix):], info["_" + key]
         if mask.all() and isinstance(values, np.ndarray):  # every step's keys: one pass
-            for env_info, value in zip(out, values.tolist(), strict=True):
+            for env_info, value in zip(out, values, strict=True):  # numpy scalars, as the env's
                 env_info[name] = value
             continue
         for i in np.flatnonzero(mask):

@@ -70,7 +70,7 @@ class TetheredAerostatVectorEnv(VectorEnv):
         self.autoreset_mode = AutoresetMode(autoreset_mode)
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"unknown render_mode {render_mode!r}; the vector env renders "
-                             "'rgb_array' (environment 0)")
+                             "'rgb_array' (a frame per environment)")
         self.render_mode = render_mode
         self.metadata = {**self.metadata, "autoreset_mode": self.autoreset_mode}
         self.task = TaskConfig.from_kwargs(**kwargs)
