@@ -22,11 +22,17 @@ from ..physics.state import StateLayout, work_size
 from ..physics.wind import W_SIZE, mean_wind, set_advection
 from ..sim import Model
 from ..sim.events import RUNNING, ground_height
-from ..wind.field import pair_decorrelations
 from . import kernel as K
 from . import reward, spaces
 from .config import TaskConfig, TaskError
-from .episodes import Episode, TrimTable, field_length_needed, sample_episode, unit_bank
+from .episodes import (
+    Episode,
+    TrimTable,
+    bank_decorrelation,
+    field_length_needed,
+    sample_episode,
+    unit_bank,
+)
 
 NO_BANK = np.zeros((1, 1, 0, 3))
 
@@ -163,7 +169,7 @@ class EnvBatch:
         bank = unit_bank(turb, self.task.wind_bank_size, self.task.wind_bank_seed, need)
         self._bank_key = (repr(turb.unit()), self.task.wind_bank_size, self.task.wind_bank_seed,
                           bank.shape)
-        self._decorrelation = pair_decorrelations(bank)
+        self._decorrelation = bank_decorrelation(bank)
         return bank
 
     def release(self) -> None:

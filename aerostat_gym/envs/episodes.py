@@ -29,7 +29,7 @@ from ..physics.wind import (
     set_row_decorrelation,
 )
 from ..sim import Model
-from ..wind.field import decorrelation_at
+from ..wind.field import decorrelation_at, pair_decorrelations
 from ..wind.presets import TurbulenceConfig
 from ..wind.synthesis import check_field_size, fft_length, veers_field
 from .config import TaskConfig, TaskError, get_parameter, perturbation
@@ -372,6 +372,9 @@ def _field(cfg, bank_shape, ua, wp, rng) -> tuple[int, float]:
 #: id -> bank already normalised; weak, so that a bank is still freed with its last
 #: environment (a dead bank's entry goes with it, so an id is never matched stale)
 _UNIT_BANKS: weakref.WeakValueDictionary = weakref.WeakValueDictionary()
+#: id -> 1 - rho of each pair of adjacent rows of a normalised bank (pair_decorrelations),
+#: computed once with the normalisation (about 50 ms for the default bank) and dropped with it
+_DECORRELATIONS: dict[int, np.ndarray] = {}
 
 
 def unit_bank(cfg: TurbulenceConfig, size: int, seed: int, length: float) -> np.ndarray:
@@ -382,7 +385,15 @@ def unit_bank(cfg: TurbulenceConfig, size: int, seed: int, length: float) -> np.
     if _UNIT_BANKS.get(id(bank)) is not bank:
         normalise_bank(bank)
         _UNIT_BANKS[id(bank)] = bank
+        _DECORRELATIONS[id(bank)] = pair_decorrelations(bank)
+        weakref.finalize(bank, _DECORRELATIONS.pop, id(bank), None)
     return bank
+
+
+def bank_decorrelation(bank: np.ndarray) -> np.ndarray:
+    """1 - rho of each pair of adjacent rows of a bank from :func:`unit_bank` (rows - 1, 3),
+    as computed when the bank was normalised."""
+    return _DECORRELATIONS[id(bank)]
 
 
 def normalise_bank(bank: np.ndarray) -> np.ndarray:
