@@ -114,6 +114,12 @@ def observation_table(full_state_size: int = 0) -> list[dict]:
     return rows
 
 
+def _froude_rate_limit(params) -> float:
+    """Body-rate clip limit [rad/s] for ``params``' hull: the table's, sized for the 18.3 m
+    baseline, times sqrt(18.3 m / hull length)."""
+    return RATE_LIMIT * math.sqrt(REFERENCE_HULL_LENGTH / params.aerostat.length)
+
+
 #: Channels whose clip limit grows with the configured aerostat, and the SI limit each needs:
 #: positions reach the winch's longest line, the length channel its whole range, the tension
 #: channels twice the tether strength (a break is at 1x), the reel speed twice the winch's top
@@ -129,16 +135,10 @@ SIZED_CHANNELS = {
     "tension": lambda p: 2.0 * p.tether.strength,
     "dtension": lambda p: 2.0 * p.tether.strength,
     "reel_speed": lambda p: 2.0 * p.winch.max_speed,
-    "p": lambda p: _froude_rate_limit(p),
-    "q": lambda p: _froude_rate_limit(p),
-    "r": lambda p: _froude_rate_limit(p),
+    "p": _froude_rate_limit,
+    "q": _froude_rate_limit,
+    "r": _froude_rate_limit,
 }
-
-
-def _froude_rate_limit(params) -> float:
-    """Body-rate clip limit [rad/s] for ``params``' hull: the table's, sized for the 18.3 m
-    baseline, times sqrt(18.3 m / hull length)."""
-    return RATE_LIMIT * math.sqrt(REFERENCE_HULL_LENGTH / params.aerostat.length)
 
 
 def bounds(full_state_size: int = 0, params=None) -> tuple[np.ndarray, np.ndarray]:
