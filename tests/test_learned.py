@@ -41,6 +41,9 @@ VARIANTS = {
         "ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
         {"residual": {"base": "modal_lqg", "scale": 0.1, "observe_estimate": True},
          "asymmetric_critic": True}, 1024),
+    "relief-residual-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
+                            {"residual": {"base": "modal_lqg", "scale": 0.1, "relief": 2.5,
+                                          "lowpass": 1.0, "deadband": 0.03}}, 1024),
     "stack-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
                   {"frame_stack": 4}, 1024),
     "score-mix-residual-ppo": ("ppo", {**ON_POLICY, "policy_kwargs": {"net_arch": [32, 32]}},
@@ -235,6 +238,38 @@ def test_observe_estimate_is_validated():
     base = load_policy("lqg", obs_noise=0.01)
     with pytest.raises(PolicyError, match="reads 19 channels per frame: fewer than the 19 standard channels and"):
         SB3Policy(Model(), None, residual=(base, CommandShaper(0.1)), observe_estimate=True)
+
+
+def test_relief_is_validated_and_relieves_the_base():
+    """``relief: R`` is a gain in (0, 10] that does not combine with observe_estimate; the base
+    built from it (training's and evaluation's alike) is the Kalman-filter base plus R top speeds
+    per net lift of load-cell tension above trim, and the base alone below trim."""
+    from aerostat_gym.agents.policies import TensionRelief, residual_base_policy
+    from aerostat_gym.agents.residual import check_residual
+    from aerostat_gym.envs.spaces import CHANNELS, OBS_DTENSION
+    from aerostat_gym.params import load_params
+
+    assert check_residual({"base": "modal_lqg", "relief": 2.5})["relief"] == 2.5
+    assert "relief" not in check_residual({"base": "modal_lqg", "relief": 0})
+    for bad in (-1.0, 10.5, float("nan"), "2"):
+        with pytest.raises(PolicyError, match="relief is a gain"):
+            check_residual({"base": "modal_lqg", "relief": bad})
+    with pytest.raises(PolicyError, match="do not combine"):
+        check_residual({"base": "modal_lqg", "relief": 1.0, "observe_estimate": True})
+
+    params = load_params()
+    res = check_residual({"base": "modal_lqg", "scale": 0.1, "relief": 2.5})
+    relieved = residual_base_policy(res, params, 0.2, 0.01)
+    plain = load_policy("modal_lqg", obs_noise=0.01)
+    assert isinstance(relieved, TensionRelief)
+    obs = np.zeros((2, N_OBS), np.float32)
+    excess = 0.1 * params.derived.net_lift  # a tenth of the net lift above trim
+    obs[0, OBS_DTENSION] = excess / CHANNELS[OBS_DTENSION].scale
+    obs[1, OBS_DTENSION] = -obs[0, OBS_DTENSION]  # below trim: no relief
+    start = np.ones(2, bool)
+    a, _ = relieved.predict(obs, episode_start=start)
+    b, _ = plain.predict(obs, episode_start=start)
+    np.testing.assert_allclose((a - b).ravel(), [0.25, 0.0], atol=1e-6)
 
 
 def test_lowpass_baseline_damps_the_small_swing_better():

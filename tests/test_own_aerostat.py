@@ -719,7 +719,11 @@ def test_families_and_sensitivity_ranges_follow_the_configuration():
     assert (slender["aerostat.k3"].low, slender["aerostat.k3"].high) == pytest.approx(
         (0.96 * 0.584 / 0.7494, 1.0))
     assert (slender["hull.eta_k"].low, slender["hull.eta_k"].high) == pytest.approx((0.225, 1.0))
+    # ... and their source text says so (it kept "x0.78-1.07" alone before 0.7.18)
+    assert slender["aerostat.k3"].source.endswith("; capped to 0.748-1, the coefficient's "
+                                                  "bounds [0, 1]")
     knobs = {k.key: k for k in default_knobs(load_params())}
+    assert all("capped" not in k.source for k in knobs.values())  # the baseline's are in range
     for key, (lo, hi) in {"fins.planform_area": (12.0, 25.0), "cm_x_shift": (-0.3, 0.3),
                           "hull.eta_k": (0.1, 0.5), "fins.CL_alpha": (1.2, 2.5),
                           "aerostat.k1": (0.086, 0.188)}.items():

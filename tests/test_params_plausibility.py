@@ -267,6 +267,27 @@ def test_unusual_values_warn(over, field):
         load_params(overrides=over)
 
 
+def test_the_envs_tether_length_warns_of_the_turbulence_height():
+    """The env's ``tether_length`` (or a ``tether.length`` override) moves the aerostat but not
+    the turbulence's reference height: a turbulent env warns when that leaves the height a
+    factor 1.5 off (0.7.18); a calm one, or one within the factor, does not."""
+    import warnings
+
+    from aerostat_gym.envs.env import TetheredAerostatEnv
+
+    text = "wind.turbulence_reference_height = 300 m is far from the aerostat's height " \
+           "(tether.length = 160 m)"
+    for kw in ({"tether_length": 160.0}, {"overrides": {"tether.length": 160.0}}):
+        with pytest.warns(ParameterWarning, match=re.escape(text)):
+            TetheredAerostatEnv(turbulence="light", **kw)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ParameterWarning)
+        TetheredAerostatEnv(turbulence="light", tether_length=250.0)  # 300 / 250 = 1.2
+        TetheredAerostatEnv(turbulence="none", tether_length=160.0)
+        TetheredAerostatEnv(turbulence="light", overrides={  # moved with the tether
+            "tether.length": 160.0, "wind.turbulence_reference_height": 160.0})
+
+
 def test_fins_without_a_mirror_panel_warn():
     panels = params_to_dict(BASE)["fins"]["panels"][:2]  # upper and port, no starboard
     with pytest.warns(ParameterWarning, match=r"fins\.panels\[1\] \('port'.*no mirror panel"):

@@ -205,9 +205,7 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
         """A saved residual block validated at the door, as (base policy, command path)."""
         res = check_residual({k: v for k, v in spec.items() if k != "obs_noise"})
         noise = check_obs_noise(spec.get("obs_noise", 0.0), PolicyError)
-        base = load_policy(res["base"], params=params, dt=dt, wind_range=wind_range,
-                           obs_noise=noise)
-        return base, residual_shaper(res, dt)
+        return residual_base_policy(res, params, dt, noise, wind_range), residual_shaper(res, dt)
 
     if name == "passive":
         return PassivePolicy()
@@ -231,6 +229,17 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise PolicyError(f"unknown policy {name!r}{hint}: use one of "
                       f"{BASELINES + tuple(SHIPPED)} or a path to a .zip")
+
+
+def residual_base_policy(res: dict, params, dt: float, obs_noise: float, wind_range=None):
+    """The base policy of a validated residual block, designed for ``params`` at control step
+    ``dt`` [s] and sensor noise ``obs_noise``; with ``relief`` it carries a
+    :class:`TensionRelief` of that gain (training and evaluation build it here alike)."""
+    base = load_policy(res["base"], params=params, dt=dt, wind_range=wind_range,
+                       obs_noise=obs_noise)
+    if res.get("relief"):
+        base = TensionRelief(base, as_params(params, PolicyError), res["relief"])
+    return base
 
 
 def _wind_range(value) -> tuple[float, float] | None:

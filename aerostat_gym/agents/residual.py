@@ -32,7 +32,7 @@ from .state_check import check_state_passed
 RESIDUAL_BASES = ("lqg", "modal_lqg", "tension")
 #: Keys of a residual block.
 RESIDUAL_KEYS = frozenset({"base", "scale", "deadband", "lowpass", "lowpass_on",
-                           "observe_estimate"})
+                           "observe_estimate", "relief"})
 #: Bases with a Kalman filter, whose estimate the learned residual can be given to read.
 ESTIMATE_BASES = ("lqg", "modal_lqg")
 #: Baselines that read the privileged full state: refused.
@@ -43,14 +43,19 @@ PRIVILEGED_BASES = ("lqr", "modal")
 #: pendulum period (36 s at 15 m/s); longer filters lag the swing they are to damp.
 MAX_LOWPASS = 4.0
 
+#: Largest tension relief accepted on a residual base [winch top speeds per net lift]: at 10 the
+#: winch saturates on a tension excess of a tenth of the net lift, a load-cell noise level.
+MAX_RELIEF = 10.0
+
 
 def check_residual(spec) -> dict:
-    """The residual block {base, scale[, deadband][, lowpass][, lowpass_on]} validated (a clear
-    PolicyError otherwise); the optional keys are returned only when they are set."""
+    """The residual block {base, scale[, deadband][, lowpass][, lowpass_on][, observe_estimate]
+    [, relief]} validated (a clear PolicyError otherwise); the optional keys are returned only
+    when they are set."""
     if not isinstance(spec, dict) or set(spec) - RESIDUAL_KEYS or "base" not in spec:
         raise PolicyError("residual must be a mapping {base: NAME, scale: S[, deadband: D]"
                           "[, lowpass: TAU][, lowpass_on: sum|base][, observe_estimate: "
-                          f"true]}}, got {spec!r}")
+                          f"true][, relief: R]}}, got {spec!r}")
     base = spec["base"]
     if base in PRIVILEGED_BASES:
         raise PolicyError(f"residual base {base!r} reads the privileged full state: learned and "
@@ -70,7 +75,22 @@ def check_residual(spec) -> dict:
         out["lowpass_on"] = check_lowpass_on(spec["lowpass_on"])
     if spec.get("observe_estimate", False) is not False:
         out["observe_estimate"] = check_observe_estimate(spec["observe_estimate"], base)
+    if spec.get("relief", 0) != 0:
+        out["relief"] = check_relief(spec["relief"], out.get("observe_estimate", False))
     return out
+
+
+def check_relief(relief, observe_estimate: bool) -> float:
+    """A tension relief on the base (:class:`aerostat_gym.agents.policies.TensionRelief`): a gain
+    in (0, MAX_RELIEF] winch top speeds per net lift. The relieved base has no filter estimate of
+    its own command, so it does not combine with ``observe_estimate``."""
+    if not (is_finite_number(relief) and 0 < relief <= MAX_RELIEF):
+        raise PolicyError(f"residual relief is a gain in (0, {MAX_RELIEF:g}] winch top speeds "
+                          f"per net lift of tension above trim, got {relief!r}")
+    if observe_estimate:
+        raise PolicyError("residual relief and observe_estimate do not combine: the estimate "
+                          "features carry the Kalman-filter base's command, not the relieved one")
+    return float(relief)
 
 
 def check_observe_estimate(flag, base: str) -> bool:

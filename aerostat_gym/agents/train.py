@@ -20,7 +20,9 @@ separate top-level block ``aerostat_gym``:
   designed for the training configuration and the training sensor noise, keeping its own
   state and reset at every episode start (:mod:`aerostat_gym.agents.residual`). With
   ``observe_estimate: true`` (Kalman-filter bases) the policy also reads the base's estimate:
-  the measured channels the filter reconstructs and the base's command.
+  the measured channels the filter reconstructs and the base's command. With ``relief: R``
+  the base carries a one-sided tension relief of R winch top speeds per net lift of load-cell
+  tension above trim (:class:`aerostat_gym.agents.policies.TensionRelief`; since 0.7.18).
 - ``score_reward: true`` (or ``{floor: F}``): train on the evaluator's score, each episode's
   rewards divided by the braked winch's return on the same episode
   (:mod:`aerostat_gym.agents.score_reward`), so that a calm 1 m swing weighs as much as a
@@ -91,7 +93,7 @@ from .hyperparams import OPTIONAL_POSITIVE as OPTIONAL_POSITIVE
 from .hyperparams import POSITIVE as POSITIVE
 from .hyperparams import PROJECT_KEYS as PROJECT_KEYS
 from .hyperparams import normalize_kwargs as normalize_kwargs
-from .policies import load_policy
+from .policies import residual_base_policy
 from .report import plot_training_curve
 from .residual import check_residual, residual_shaper, residual_vec_env
 from .sb3io import (
@@ -147,10 +149,8 @@ def residual_base(spec: dict, env_kwargs: dict):
     res = spec.get("residual")
     if not res:
         return None
-    params = env_kwargs.get("params")
-    params = as_params(params)
-    return load_policy(res["base"], params=params, dt=float(env_kwargs.get("control_step", 0.2)),
-                       obs_noise=res["obs_noise"])
+    return residual_base_policy(res, as_params(env_kwargs.get("params")),
+                                float(env_kwargs.get("control_step", 0.2)), res["obs_noise"])
 
 
 def make_training_env(n_envs: int, seed: int, env_kwargs: dict, normalize: dict | None,

@@ -114,10 +114,14 @@ def _rel(base: float, low: float, high: float) -> tuple[float, float]:
     return base * low, base * high
 
 
-def _fraction(lo_hi: tuple[float, float]) -> tuple[float, float]:
-    """A range of a coefficient that lies in [0, 1] (Lamb's k1 and k3, eta_k), kept there: a
-    slender hull's k3 of 0.96 times the baseline's factor 1.07 would end at an invalid 1.03."""
-    return min(max(lo_hi[0], 0.0), 1.0), min(max(lo_hi[1], 0.0), 1.0)
+def _fraction(lo_hi: tuple[float, float], source: str) -> tuple[tuple[float, float], str]:
+    """A range of a coefficient that lies in [0, 1] (Lamb's k1 and k3, eta_k), kept there, and
+    its source text saying so where it was cut: a slender hull's k3 of 0.96 times the
+    baseline's factor 1.07 would end at an invalid 1.03."""
+    kept = min(max(lo_hi[0], 0.0), 1.0), min(max(lo_hi[1], 0.0), 1.0)
+    if kept != tuple(lo_hi):
+        source += f"; capped to {kept[0]:.3g}-{kept[1]:.3g}, the coefficient's bounds [0, 1]"
+    return kept, source
 
 
 #: Half-width of the CM and CB position ranges in hull lengths: the baseline's +-0.3 m on its
@@ -142,8 +146,9 @@ def default_knobs(params: Params | None = None) -> list[Knob]:
     def add(key, label, status, unit, lo_hi, source, getput):
         ks.append(Knob(key, label, status, unit, float(lo_hi[0]), float(lo_hi[1]), source, *getput))
 
-    add("hull.eta_k", "hull efficiency eta_k", "CALIB", "-", _fraction(_rel(h.eta_k, 0.25, 1.25)),
-        "x0.25-1.25 (baseline 0.1-0.5: >= 0.5 yaw-divergent, sec. 5)", _dotted("hull.eta_k"))
+    add("hull.eta_k", "hull efficiency eta_k", "CALIB", "-", *_fraction(
+        _rel(h.eta_k, 0.25, 1.25), "x0.25-1.25 (baseline 0.1-0.5: >= 0.5 yaw-divergent, sec. 5)"),
+        _dotted("hull.eta_k"))
     add("fins.CL_alpha", "fin lift slope C_L_alpha", "CALIB", "1/rad",
         _rel(f.CL_alpha, 1.2 / 1.43, 2.5 / 1.43),
         "x0.84-1.75 (baseline 1.2-2.5 about 1.43, sec. 1d)", _dotted("fins.CL_alpha"))
@@ -167,11 +172,11 @@ def default_knobs(params: Params | None = None) -> list[Knob]:
         "x0.25-1 (baseline 0.3-1.2: supercritical to subcritical cylinder, sec. 1c)",
         _dotted("hull.Cdc"))
     add("aerostat.k1", "axial added-mass coeff. k1", "ESTIMATE", "-",
-        _fraction(_rel(a.k1, 0.086 / 0.1672, 0.188 / 0.1672)),
-        "x0.51-1.12 (baseline Table 2 fits 0.086-0.188, sec. 2)", _dotted("aerostat.k1"))
+        *_fraction(_rel(a.k1, 0.086 / 0.1672, 0.188 / 0.1672),
+                   "x0.51-1.12 (baseline Table 2 fits 0.086-0.188, sec. 2)"), _dotted("aerostat.k1"))
     add("aerostat.k3", "lateral added-mass coeff. k3", "ESTIMATE", "-",
-        _fraction(_rel(a.k3, 0.584 / 0.7494, 0.803 / 0.7494)),
-        "x0.78-1.07 (baseline Table 2 fits 0.584-0.803, sec. 2)", _dotted("aerostat.k3"))
+        *_fraction(_rel(a.k3, 0.584 / 0.7494, 0.803 / 0.7494),
+                   "x0.78-1.07 (baseline Table 2 fits 0.584-0.803, sec. 2)"), _dotted("aerostat.k3"))
     add("environment.rho_air", "air density (net lift kept)", "DERIVED", "kg/m^3",
         _rel(p.environment.rho_air, 1.120 / 1.147, 1.225 / 1.147),
         "x0.976-1.068 (baseline 1.120-1.225, sec. 2); mass adjusted", _rho_keep_lift())

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 
@@ -18,6 +19,7 @@ from ..params import (
     SECTIONS,
     InertiaError,
     ParameterError,
+    ParameterWarning,
     Params,
     apply_overrides,
     as_params,
@@ -25,6 +27,7 @@ from ..params import (
     check_plausibility,
     parameter_key,
     params_to_dict,
+    turbulence_height_warnings,
 )
 from ..sim import INTEGRATORS
 from ..wind.presets import INTENSITY_CLASSES
@@ -172,11 +175,16 @@ class TaskConfig:
             over["tether.length"] = self.tether_length
         if self.n_elements is not None:
             over["tether.n_elements"] = self.n_elements
-        p = apply_overrides(p, over) if over else p
+        moved = apply_overrides(p, over) if over else p
         # the env is a door like the loader: overrides and a Params built by replace() meet the
         # same plausibility bounds as a parameter file
-        check_plausibility(p)
-        return p
+        check_plausibility(moved)
+        calm = self.turbulence in (None, "none") and not self.turbulence_mix
+        if not calm and not turbulence_height_warnings(p):  # a file's own was warned at load
+            for text in turbulence_height_warnings(moved):
+                warnings.warn(f"the environment's tether length: {text}", ParameterWarning,
+                              stacklevel=6)
+        return moved
 
     def _randomize(self, params: Params) -> dict:
         if self.randomize is None or self.randomize is False:

@@ -325,6 +325,10 @@ class TetheredAerostatEnv(gym.Env):
       ``DummyVecEnv``'s at every step (empty but at an episode's end before), its
       ``get_images`` returns the frames, and it refuses ``env_method`` (which called the whole
       batch's method once per index) and ``set_attr`` on some environments only.
+    - v0 (aerostat-gym 0.7.18; dynamics, observation, reward and episodes unchanged): a
+      turbulent env whose ``tether_length`` (or ``tether.length`` override) leaves the
+      turbulence reference height a factor 1.5 off warns (``ParameterWarning``), as loading
+      such a file does.
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}

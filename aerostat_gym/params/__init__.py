@@ -81,6 +81,7 @@ from .plausible import (
     check_plausibility,
     hull_integral_warnings,
     plausibility_warnings,
+    turbulence_height_warnings,
 )
 from .schema import (
     ANY,
@@ -140,6 +141,6 @@ __all__ = [
     "apply_overrides", "as_params", "check_inertia", "check_length_within_winch", "check_limits",
     "check_plausibility", "default_params", "dumps_toml", "froude_step", "hull_integral_warnings",
     "load_params", "paid_out_weight", "parameter_key", "parameter_table", "params_from_dict",
-    "params_to_dict", "plausibility_warnings", "shipped_configs", "status_comments",
+    "params_to_dict", "plausibility_warnings", "turbulence_height_warnings", "shipped_configs", "status_comments",
     "status_slips", "tether_drag_step", "validated",
 ]

@@ -315,13 +315,7 @@ def plausibility_warnings(p: Params) -> list[str]:
     if p.hull.Cdc > HULL_CDC_WARN:
         out.append(f"hull.Cdc = {p.hull.Cdc:g} is above a circular cylinder's 0.3-1.2 "
                    f"(warning above {HULL_CDC_WARN:g})")
-    ref, length = p.wind.turbulence_reference_height, t.length
-    if not length / TURBULENCE_HEIGHT_WARN <= ref <= length * TURBULENCE_HEIGHT_WARN:
-        out.append(f"wind.turbulence_reference_height = {ref:g} m is far from the aerostat's "
-                   f"height (tether.length = {length:g} m): the turbulence's intensity, length "
-                   f"scales and advection are those at {ref:g} m; set it near the height the "
-                   "aerostat flies at (the shipped files and scale_aerostat use the tether "
-                   f"length; warning outside a factor {TURBULENCE_HEIGHT_WARN:g} of it)")
+    out.extend(turbulence_height_warnings(p))
     full = paid_out_weight(p, p.winch.max_length)
     if d.net_lift <= full:
         reach = d.net_lift / paid_out_weight(p, 1.0)
@@ -332,6 +326,19 @@ def plausibility_warnings(p: Params) -> list[str]:
                    "winch; lower winch.max_length or widen the margin")
     out.extend(_fin_symmetry_warnings(p))
     return out
+
+
+def turbulence_height_warnings(p: Params) -> list[str]:
+    """The turbulence reference height far from the height the aerostat flies at (a factor
+    :data:`TURBULENCE_HEIGHT_WARN` off the tether length): a list of one text, or empty."""
+    ref, length = p.wind.turbulence_reference_height, p.tether.length
+    if length / TURBULENCE_HEIGHT_WARN <= ref <= length * TURBULENCE_HEIGHT_WARN:
+        return []
+    return [f"wind.turbulence_reference_height = {ref:g} m is far from the aerostat's "
+            f"height (tether.length = {length:g} m): the turbulence's intensity, length "
+            f"scales and advection are those at {ref:g} m; set it near the height the "
+            "aerostat flies at (the shipped files and scale_aerostat use the tether "
+            f"length; warning outside a factor {TURBULENCE_HEIGHT_WARN:g} of it)"]
 
 
 def _fin_symmetry_warnings(p: Params) -> list[str]:
