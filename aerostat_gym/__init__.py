@@ -22,9 +22,10 @@ __version__ = "0.7.18"
 #: turbulent tasks: the aerostat, flying between the turbulence field's height rows, feels the
 #: class's full sigma (3 / 5 / 8 % more in u / v / w than before, which the interpolation between
 #: rows lost); calm-air episodes are bit-identical, turbulent ones differ, and a policy trained
-#: before (the shipped one, on the light turbulence of TetheredAerostatRealistic-v0) runs in the
-#: turbulence its class states, a few per cent stronger than the one it was trained in.
-TASKS_COMPATIBLE_SINCE = "0.4.0"
+#: before runs in the turbulence its class states, a few per cent stronger than the one it was
+#: trained in. So the oldest compatible version is 0.7.17 (0.4.0 until 0.7.17, when the shipped
+#: policy was 0.4.0's; the one shipped since 0.7.18 was trained by 0.7.17).
+TASKS_COMPATIBLE_SINCE = "0.7.17"
 
 register()
 
