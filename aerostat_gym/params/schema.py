@@ -49,7 +49,8 @@ def _f(unit: str, status: str, check: str = ANY, doc: str = "", default: Any = d
 
 @dataclass(frozen=True)
 class EnvironmentParams:
-    rho_air: float = _f("kg/m^3", "DERIVED", POSITIVE, "air density (baseline: the Table 2 fit, Option A)")
+    rho_air: float = _f("kg/m^3", "DERIVED", POSITIVE,
+                        "air density (baseline: the Table 2 fit, Option A)")
     g: float = _f("m/s^2", "ESTIMATE", POSITIVE, "gravitational acceleration")
 
 
@@ -108,8 +109,9 @@ class FinPanel:
 class FinParams:
     planform_area: float = _f("m^2", "ESTIMATE", NONNEG, "planform area per fin")
     aspect_ratio: float = _f("-", "ESTIMATE", POSITIVE, "aspect ratio used for induced drag")
-    CL_alpha: float = _f("1/rad", "CALIB", NONNEG, "3-D lift slope incl. hull interference loss (baseline: "
-                      "calibrated, 0.68 x McCormick, to the 67.4 s lateral pendulum)")
+    CL_alpha: float = _f("1/rad", "CALIB", NONNEG, "3-D lift slope incl. hull interference loss "
+                         "(baseline: calibrated, 0.68 x McCormick, to the 67.4 s lateral "
+                         "pendulum)")
     alpha_stall_deg: float = _f("deg", "CALIB", STALL, "3-D stall angle of the low-aspect-ratio "
                                 "fin (linear C_L below it) (baseline: calibrated to a restoring "
                                 "static yaw moment at every yaw offset to 90 deg)")
