@@ -270,16 +270,24 @@ def test_unusual_values_warn(over, field):
 def test_the_envs_tether_length_warns_of_the_turbulence_height():
     """The env's ``tether_length`` (or a ``tether.length`` override) moves the aerostat but not
     the turbulence's reference height: a turbulent env warns when that leaves the height a
-    factor 1.5 off (0.7.18); a calm one, or one within the factor, does not."""
+    factor 1.5 off (0.7.18), at the caller's line; a calm one, or one within the factor, does
+    not."""
     import warnings
 
+    import gymnasium as gym
+
+    import aerostat_gym  # noqa: F401  (registers the tasks)
     from aerostat_gym.envs.env import TetheredAerostatEnv
 
     text = "wind.turbulence_reference_height = 300 m is far from the aerostat's height " \
            "(tether.length = 160 m)"
     for kw in ({"tether_length": 160.0}, {"overrides": {"tether.length": 160.0}}):
-        with pytest.warns(ParameterWarning, match=re.escape(text)):
+        with pytest.warns(ParameterWarning, match=re.escape(text)) as record:
             TetheredAerostatEnv(turbulence="light", **kw)
+        assert record[0].filename == __file__  # the user's line, not the package's
+    with pytest.warns(ParameterWarning, match=re.escape(text)) as record:
+        gym.make("TetheredAerostat-v0", turbulence="light", tether_length=160.0)
+    assert record[0].filename == __file__  # past gymnasium's frames too
     with warnings.catch_warnings():
         warnings.simplefilter("error", ParameterWarning)
         TetheredAerostatEnv(turbulence="light", tether_length=250.0)  # 300 / 250 = 1.2

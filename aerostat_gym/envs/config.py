@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import sys
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
@@ -183,7 +184,7 @@ class TaskConfig:
         if not calm and not turbulence_height_warnings(p):  # a file's own was warned at load
             for text in turbulence_height_warnings(moved):
                 warnings.warn(f"the environment's tether length: {text}", ParameterWarning,
-                              stacklevel=6)
+                              stacklevel=_user_stacklevel())
         return moved
 
     def _randomize(self, params: Params) -> dict:
@@ -203,6 +204,18 @@ class TaskConfig:
     @property
     def params_resolved(self) -> Params:
         return self.resolved["params"]
+
+
+def _user_stacklevel() -> int:
+    """The ``stacklevel`` that makes a warning raised by this function's caller point at the
+    user's line: the first frame whose module is outside this package and gymnasium
+    (``gym.make``, the environment's constructor and the dataclass's generated ``__init__``
+    sit between)."""
+    frame, level = sys._getframe(2), 2
+    while frame is not None and frame.f_globals.get("__name__", "").split(".")[0] in (
+            "aerostat_gym", "gymnasium"):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 def turbulence_mix(spec, turb, given) -> tuple[tuple[str, ...], np.ndarray] | None:

@@ -328,7 +328,7 @@ class TetheredAerostatEnv(gym.Env):
     - v0 (aerostat-gym 0.7.18; dynamics, observation, reward and episodes unchanged): a
       turbulent env whose ``tether_length`` (or ``tether.length`` override) leaves the
       turbulence reference height a factor 1.5 off warns (``ParameterWarning``), as loading
-      such a file does.
+      such a file does, at the caller's line (past gymnasium's frames under ``gym.make``).
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}
