@@ -231,15 +231,14 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
                       f"{BASELINES + tuple(SHIPPED)} or a path to a .zip")
 
 
-def residual_base_policy(res: dict, params, dt: float, obs_noise: float, wind_range=None):
+def residual_base_policy(res: dict, params: Params, dt: float, obs_noise: float,
+                         wind_range=None):
     """The base policy of a validated residual block, designed for ``params`` at control step
     ``dt`` [s] and sensor noise ``obs_noise``; with ``relief`` it carries a
     :class:`TensionRelief` of that gain (training and evaluation build it here alike)."""
     base = load_policy(res["base"], params=params, dt=dt, wind_range=wind_range,
                        obs_noise=obs_noise)
-    if res.get("relief"):
-        base = TensionRelief(base, as_params(params, PolicyError), res["relief"])
-    return base
+    return TensionRelief(base, params, res["relief"]) if res.get("relief") else base
 
 
 def _wind_range(value) -> tuple[float, float] | None:

@@ -48,8 +48,6 @@ SEMI_IMPLICIT_REFUSE_FACTOR = 2.0
 #: 12-15 %); nylon, the stretchiest rope fibre, at 20-40 %. Above WARN: unusual (a nylon-like
 #: line); above MAX: no rope stretches to twice its length before breaking.
 TETHER_BREAK_STRAIN_WARN = 0.25
-#: wind.turbulence_reference_height more than this factor from tether.length warns at load
-TURBULENCE_HEIGHT_WARN = 1.5
 TETHER_BREAK_STRAIN_MAX = 1.0
 #: Strain of the tether under the still-air net lift, net lift / EA: a tether is loaded at a
 #: fraction of its strength, so a real one stretches well under 10 %; a modulus so low that
@@ -86,6 +84,8 @@ LEASH_DEPTH_MAX = 3.0
 #: 0.3-1.2 (super- to subcritical), a flat plate 2.0, a concave half-cylinder face 2.3, the
 #: largest of any section. Above WARN: unusual; above MAX: no section.
 HULL_CDC_WARN, HULL_CDC_MAX = 1.5, 3.0
+#: wind.turbulence_reference_height more than this factor from tether.length warns at load
+TURBULENCE_HEIGHT_WARN = 1.5
 
 
 def slip_hint(value: float, factors: dict[str, float], ok) -> str:
