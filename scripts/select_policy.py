@@ -10,6 +10,8 @@ Usage::
         --policy modal_lqg --policy modal_lqg_shaped
     aerostat-gym evaluate --suite validation --out runs/val/cand --no-plots \\
         --policy runs/seeds/s0/ppo_final.zip ... --policy runs/seeds/s4/ppo_final.zip
+    (a candidate evaluated in a run of its own: ``--label s4/ppo_final``, or its label is the
+    bare stem ``ppo_final`` and a second such run clashes with it)
     PYTHONPATH=. python scripts/select_policy.py runs/val/base/report.json \\
         runs/val/cand/report.json --candidates s0/ppo_final ... s4/ppo_final \\
         [--names "seed 0" ... "seed 4"] --out agents/ppo_training

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -304,6 +305,22 @@ def test_policy_labels_stay_distinct():
                                               "b/ppo_final", "model"]
     with pytest.raises(ValueError, match="listed twice"):
         policy_labels(["lqr", "lqr"])
+
+
+def test_given_labels_name_models_of_separate_runs():
+    """``evaluate --label`` names each policy (so that the ``ppo_final`` of runs evaluated one
+    at a time can be read back together); a count that differs from the policies', an empty
+    label or one given twice is refused, naming the fault."""
+    from aerostat_gym.agents.report import given_labels, run_evaluations
+
+    assert given_labels(["s4", "passive"], ["runs/s4/ppo_final.zip", "passive"]) == ["s4",
+                                                                                     "passive"]
+    for labels, needle in ((["a"], "1 label(s) for 2 --policy"), (["a", " "], "label 2 is empty"),
+                           (["a", "a"], "'a' is given twice")):
+        with pytest.raises(ValueError, match=re.escape(needle)):
+            given_labels(labels, ["passive", "lqr"])
+    rows = run_evaluations(["passive"], "tiny", progress=False, labels=["braked"])
+    assert [r["label"] for r in rows] == ["braked"]
 
 
 def test_poi_split_on_constructed_results():

@@ -345,11 +345,28 @@ def cell_means(episodes: list[dict]) -> list[dict]:
     return cells
 
 
+def given_labels(labels: list[str], policies: list[str]) -> list[str]:
+    """The user's names for ``policies`` (one each, in order), checked: as many as policies,
+    non-empty, distinct. They keep apart models evaluated in separate runs that would all be
+    labelled by their file stem (``ppo_final``), so that the runs can be read back together
+    (:func:`load_results` refuses a label twice)."""
+    if len(labels) != len(policies):
+        raise ValueError(f"--label: {len(labels)} label(s) for {len(policies)} --policy; give "
+                         "one per --policy, in the same order")
+    blank = [i + 1 for i, lab in enumerate(labels) if not lab.strip()]
+    if blank:
+        raise ValueError(f"--label: label {blank[0]} is empty")
+    twice = sorted({lab for lab in labels if labels.count(lab) > 1})
+    if twice:
+        raise ValueError(f"--label: {twice[0]!r} is given twice; labels must be distinct")
+    return list(labels)
+
+
 def run_evaluations(policies: list[str], suite: str, progress: bool = True,
-                    params=None, speeds=None) -> list[dict]:
+                    params=None, speeds=None, labels=None) -> list[dict]:
     """Evaluate every policy on ``suite`` (at ``speeds`` if given) in the environment of
-    ``params`` (default baseline)."""
-    labels = policy_labels(policies)
+    ``params`` (default baseline), labelled ``labels`` (default :func:`policy_labels`)."""
+    labels = policy_labels(policies) if labels is None else given_labels(labels, policies)
     results = []
     for name, label in zip(_progress(policies, progress, "evaluating"), labels, strict=True):
         r = evaluate_policy(name, suite, params=params, speeds=speeds)

@@ -11,6 +11,7 @@ from ..agents.hyperparams import ALGOS
 from ..agents.policies import BASELINES, SHIPPED, load_policy
 from ..agents.report import (
     comparison_table,
+    given_labels,
     jsonable,
     protocol_for,
     run_evaluations,
@@ -78,6 +79,11 @@ def add_evaluate_parser(sub) -> None:
                    help="run every scenario of the suite at these mean wind speeds [m/s] "
                    "instead of its own (same seeds, noise and durations; the baselines are "
                    "scheduled over the range that covers them)")
+    p.add_argument("--label", action="append", metavar="NAME",
+                   help="name of each --policy in the tables and report.json, one per --policy "
+                   "in order (default: a baseline's name, a model's file stem, or its run "
+                   "directory and stem where two stems clash); keeps models evaluated in "
+                   "separate runs apart when the runs are read back together")
     p.add_argument("--out", default="runs/evaluate", help="report directory")
     p.add_argument("--json", action="store_true", help="print the metrics as JSON")
     p.add_argument("--no-plots", action="store_true", help="write no PNG plots")
@@ -114,12 +120,14 @@ def _check_suite_winds(suite: str, speeds, params) -> None:
 def _evaluate_command(args) -> int:
     if not args.no_plots:
         require_plotting("writing evaluate's plots (--no-plots skips them)")
+    if args.label is not None:
+        given_labels(args.label, args.policy)
     _check_policies(args.policy)
     params = params_from_args(args)
     _check_suite_winds(args.suite, args.speeds, params)
     out = output_dir(args.out)
     results = run_evaluations(args.policy, args.suite, progress=not args.json, params=params,
-                              speeds=args.speeds)
+                              speeds=args.speeds, labels=args.label)
     md = write_report(results, out, f"Evaluation on suite `{args.suite}`",
                       "aerostat-gym " + " ".join(sys.argv[1:]), plots=not args.no_plots)
     if args.json:
