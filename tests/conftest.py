@@ -3,11 +3,29 @@
 ``ray_session``: one local Ray instance with two CPUs for every test that needs Ray (start-up
 costs a few seconds, so it is paid once). Tests that use it are skipped, with the reason, when
 the optional ``ray`` extra is not installed.
+
+``load_script``: a script of ``scripts/`` as a module, by name (the scripts are thin shims
+over the library, and not a package).
 """
 
 from __future__ import annotations
 
+import importlib.util
+from pathlib import Path
+
 import pytest
+
+SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
+
+
+@pytest.fixture(scope="session")
+def load_script():
+    def load(name: str):
+        spec = importlib.util.spec_from_file_location(name, SCRIPTS / f"{name}.py")
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        return mod
+    return load
 
 
 @pytest.fixture(scope="session")

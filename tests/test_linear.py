@@ -472,18 +472,11 @@ def test_full_sensitivity_table(base):
         assert rows[key]["max_abs_pct"] < 1.0
 
 
-def test_scripts_reproduce_into_folder(tmp_path):
+def test_scripts_reproduce_into_folder(tmp_path, load_script):
     """The three reproduction scripts run and write their files."""
-    import importlib.util
-    from pathlib import Path
-
-    root = Path(__file__).resolve().parents[1] / "scripts"
     for name, extra in (("reproduce_table2", ["--no-sensitivity"]), ("reproduce_figure8", []),
                         ("reproduce_figure9", ["--no-families"])):
-        spec = importlib.util.spec_from_file_location(name, root / f"{name}.py")
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)
-        assert mod.main(["--out", str(tmp_path), *extra]) == 0
+        assert load_script(name).main(["--out", str(tmp_path), *extra]) == 0
     for f in ("table2.json", "figure8.png", "figure8_amplitude_scan.csv", "figure8_readings.csv",
               "figure8_decomposition.csv", "figure9.png"):
         assert (tmp_path / f).exists()

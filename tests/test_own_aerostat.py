@@ -17,12 +17,10 @@ The default suite runs the shipped aerostats and two generated ones with short s
 ``slow`` test runs the full 0..20 m/s sweeps, the Figure 8 script and the agent commands.
 """
 
-import importlib.util
 import json
 import math
 import warnings
 from collections import Counter
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -116,15 +114,6 @@ def case(request, tmp_path_factory):
     path = tmp_path_factory.mktemp(name) / f"{name}.toml"
     path.write_text(dumps_toml(p))
     return name, p, str(path)
-
-
-def _script(name):
-    """A script of scripts/ as a module (they are thin shims over the library)."""
-    path = Path(__file__).resolve().parents[1] / "scripts" / f"{name}.py"
-    spec = importlib.util.spec_from_file_location(name, path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def _run(capsys, argv):
@@ -549,7 +538,7 @@ def test_lqr_nonlinear_damping_matches_prediction(name):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", CASES)
-def test_own_aerostat_full(name, tmp_path, capsys):
+def test_own_aerostat_full(name, tmp_path, capsys, load_script):
     """Fuller version: 0..20 m/s in 1 m/s steps all stable, the LQR damping check, evaluate and
     demo with --config (resolved parameters recorded), the Figure 8 and Table 2 scripts with
     --config (Figure 8 on the configured length, Table 2 rows in their bands), and train for
@@ -574,7 +563,7 @@ def test_own_aerostat_full(name, tmp_path, capsys):
     _no_baseline_numbers(name, text)
     for script, extra in (("reproduce_figure8", []), ("reproduce_table2", ["--no-sensitivity"])):
         out_dir = tmp_path / script
-        assert _script(script).main(["--out", str(out_dir), "--config", str(cfg), *extra]) == 0
+        assert load_script(script).main(["--out", str(out_dir), "--config", str(cfg), *extra]) == 0
     fig8 = json.loads((tmp_path / "reproduce_figure8" / "figure8.json").read_text())
     assert fig8["tether_length_m"] == p.tether.length
     rows = json.loads((tmp_path / "reproduce_table2" / "table2.json").read_text())

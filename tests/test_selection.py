@@ -3,10 +3,8 @@ the rule's verdicts on constructed results whose answer is known in closed form,
 on the aggregate, the task-return gate before them, and the validation suite disjoint from the
 report suite."""
 
-import importlib.util
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -168,20 +166,12 @@ def test_gate_seeds_are_their_own():
     assert len(GATE_SEEDS) == 200
 
 
-def _script(name):
-    path = Path(__file__).resolve().parents[1] / "scripts" / f"{name}.py"
-    spec = importlib.util.spec_from_file_location(name, path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-def test_task_gate_script_writes_what_select_policy_reads(tmp_path, capsys):
+def test_task_gate_script_writes_what_select_policy_reads(tmp_path, capsys, load_script):
     """scripts/task_gate.py on two gate seeds: the returns of the incumbent, a challenger (two
     baselines standing in for trained models) and a baseline for the record are written under
     their labels, the challenger's difference printed; select_policy's reader merges two such
     files and refuses a label twice or files of other seeds or incumbents."""
-    gate_script, sel_script = _script("task_gate"), _script("select_policy")
+    gate_script, sel_script = load_script("task_gate"), load_script("select_policy")
     out = tmp_path / "a.json"
     rec = gate_script.main(["--incumbent", "inc", "--policy", "modal_lqg", "--label", "inc",
                             "--policy", "modal", "--label", "cand", "--baselines", "passive",
@@ -208,7 +198,7 @@ def test_task_gate_script_writes_what_select_policy_reads(tmp_path, capsys):
                           "--out", str(out)])
 
 
-def test_the_stored_selection_keeps_the_shipped_policy_behind_the_gate():
+def test_the_stored_selection_keeps_the_shipped_policy_behind_the_gate(load_script):
     """agents/ppo_training/selection.json, the record of the shipped choice, agrees with the
     gate recomputed from its stored returns: its first-ranked candidate is the incumbent, whose
     run is the shipped training run; every challenger's stored verdict is the recomputed one
@@ -216,7 +206,7 @@ def test_the_stored_selection_keeps_the_shipped_policy_behind_the_gate():
     from aerostat_gym.resources import shipped_path
 
     sel = json.loads(shipped_path("ppo_training", "selection.json").read_text())
-    returns, incumbent = _script("select_policy").read_gate(
+    returns, incumbent = load_script("select_policy").read_gate(
         [shipped_path("ppo_training", f"task_gate_{part}.json") for part in "ab"])
     command = shipped_path("ppo_training", "command.txt").read_text().split()
     assert command[command.index("--run-dir") + 1].endswith("/" + incumbent.split("/")[0])

@@ -231,15 +231,9 @@ def test_reel_out_and_back_returns_to_trim(base, integrator):
     assert not any(e["event"] in ("break", "over_tension", "winch_slack") for e in tr.events)
 
 
-def test_manoeuvre_script_writes_png(tmp_path):
+def test_manoeuvre_script_writes_png(tmp_path, load_script):
     """The script shim runs end to end (short settle) and writes the PNG."""
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[1] / "scripts" / "winch_manoeuvre.py"
-    spec = importlib.util.spec_from_file_location("winch_manoeuvre", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = load_script("winch_manoeuvre")
     out = tmp_path / "m.png"
     assert mod.main(["--distance", "5", "--hold", "2", "--settle", "5", "--integrator",
                      "semi-implicit", "--out", str(out)]) == 0

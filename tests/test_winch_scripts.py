@@ -3,29 +3,18 @@ the frontier figure from synthetic rows (fast) and a one-point frontier run agai
 figures (slow). Every assertion states its tolerance.
 """
 
-import importlib.util
 import json
-from pathlib import Path
 
 import pytest
 
 from aerostat_gym.agents.frontier import saturated_speeds
 from aerostat_gym.params import load_params
 
-ROOT = Path(__file__).resolve().parents[1]
 
-
-def load(name):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "scripts" / f"{name}.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-def test_frontier_table_format_and_targets():
+def test_frontier_table_format_and_targets(load_script):
     """One row formats to the 8-column Markdown table (designed zeta blank where there is none);
     the modal targets rise with wind speed and lie in (0, 1)."""
-    fr = load("winch_frontier")
+    fr = load_script("winch_frontier")
     row = {"wind_speed": 10.0, "policy": "modal", "kind": "modal", "designed_zeta": 0.6,
            "zeta": 0.545, "zeta_drift": 0.611, "peak_set_point_m_s": 0.716,
            "peak_reel_speed_m_s": 0.715, "length_wander_m": 8.49}
@@ -53,11 +42,11 @@ def _synthetic_rows():
     return rows
 
 
-def test_frontier_plot_writes_png(tmp_path):
+def test_frontier_plot_writes_png(tmp_path, load_script):
     """Synthetic rows draw three panels (one per wind speed) into a PNG of more than 10 kB; the
     5 m/s authority bound is a horizontal line there only; the modal runs saturating the winch
     mark that speed (frontier.saturated_speeds)."""
-    fr = load("winch_frontier")
+    fr = load_script("winch_frontier")
     rows = _synthetic_rows()
     limits = [{"wind_speed": U, "zeta": z, "peak_set_point_m_s": 1.0, "authority": U == 5.0}
               for U, z in ((5.0, 0.22), (10.0, 0.80), (15.0, 0.99))]
@@ -75,10 +64,10 @@ def test_frontier_plot_writes_png(tmp_path):
     assert saturated_speeds(rows) == [] and saturated_speeds(sat) == [5.0]
 
 
-def test_frontier_point_reproduces():
+def test_frontier_point_reproduces(load_script):
     """The modal point at 10 m/s, zeta 0.6, 10 m swing, shipped winch: measured 1-mode 0.545 and
     drift fit 0.611, peak reel speed 0.715 m/s (each to 0.005). (3 s: in the default run.)"""
-    fr = load("winch_frontier")
+    fr = load_script("winch_frontier")
     (row,) = fr.modal_curve_at(load_params(), 10.0, 10.0, (0.6,))
     assert row["designed_zeta"] == 0.6
     assert row["zeta"] == pytest.approx(0.545, abs=0.005)
@@ -86,7 +75,7 @@ def test_frontier_point_reproduces():
     assert row["peak_reel_speed_m_s"] == pytest.approx(0.715, abs=0.005)
 
 
-def test_poi_split_script_writes_its_table(tmp_path, capsys):
+def test_poi_split_script_writes_its_table(tmp_path, capsys, load_script):
     """scripts/poi_split.py on a constructed two-cell report prints and writes the table and
     rows the library gives (a calm cell won outright, a tied turbulent cell: P 0.75, and so the
     bound); an unknown label is one line naming it."""
@@ -98,7 +87,7 @@ def test_poi_split_script_writes_its_table(tmp_path, capsys):
 
     report = tmp_path / "report.json"
     report.write_text(json.dumps([res("passive", -2.0, -20.0), res("a", -1.0, -20.0)]))
-    split = load("poi_split")
+    split = load_script("poi_split")
     split.main([str(report), "--x", "a", "--y", "passive", "--markdown",
                 str(tmp_path / "s.md"), "--json", str(tmp_path / "s.json")])
     row = json.loads((tmp_path / "s.json").read_text())[0]
