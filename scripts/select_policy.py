@@ -97,6 +97,9 @@ def read_gate(paths) -> tuple[dict, str]:
     returns, keys = {}, set()
     for path in paths:
         record = json.loads(Path(path).read_text())
+        missing = sorted({"task", "seeds", "incumbent", "returns"} - set(record))
+        if missing:
+            raise ValueError(f"{path} is not a scripts/task_gate.py record: no {missing}")
         keys.add((record["task"], tuple(record["seeds"]), record["incumbent"]))
         if len(keys) > 1:
             raise ValueError(f"the gate files {list(map(str, paths))} ran different tasks, "

@@ -193,6 +193,10 @@ def test_task_gate_script_writes_what_select_policy_reads(tmp_path, capsys, load
         other.write_text(json.dumps({**rec, **change, "returns": {}}))
         with pytest.raises(ValueError, match="ran different tasks, seeds or incumbents"):
             sel_script.read_gate([out, other])
+    other.write_text(json.dumps({"returns": {}}))
+    with pytest.raises(ValueError, match=r"not a scripts/task_gate.py record: no \['incumbent', "
+                                         r"'seeds', 'task'\]"):
+        sel_script.read_gate([other])
     with pytest.raises(SystemExit, match="--seeds must lie in"):
         gate_script.main(["--incumbent", "x", "--policy", "modal", "--seeds", "1",
                           "--out", str(out)])
