@@ -28,9 +28,12 @@ from aerostat_gym.agents.returns import task_returns
 from aerostat_gym.agents.selection import GATE_SEEDS, task_gate
 from aerostat_gym.cli.common import run_script, script_description
 from aerostat_gym.registration import TASKS
+from aerostat_gym.resources import shipped_path
 
-#: The task every shipped residual so far was trained on.
-DEFAULT_TASK = "TetheredAerostatRealistic-v0"
+
+def shipped_task() -> str:
+    """The task the shipped policy was trained on (its training summary's)."""
+    return json.loads(shipped_path("ppo_training", "training_summary.json").read_text())["task"]
 
 
 def main(argv=None) -> dict:
@@ -43,8 +46,8 @@ def main(argv=None) -> dict:
                     help="label of the shipped policy the challengers are compared with")
     ap.add_argument("--baselines", nargs="*", default=[],
                     help="baselines to run too, for the record")
-    ap.add_argument("--task", default=DEFAULT_TASK, choices=sorted(TASKS),
-                    help="the candidates' training task")
+    ap.add_argument("--task", default=None, choices=sorted(TASKS),
+                    help="the incumbent's training task (default: the shipped policy's)")
     ap.add_argument("--seeds", type=int, default=len(GATE_SEEDS),
                     help="the first N gate seeds (a smoke run)")
     ap.add_argument("--out", required=True, help="JSON file of the returns")
@@ -58,9 +61,10 @@ def main(argv=None) -> dict:
     if len(set(names)) != len(names):
         raise SystemExit(f"a label is given twice: {names}")
     seeds = GATE_SEEDS[:args.seeds]
+    task = args.task or shipped_task()
     runs = [*((b, b) for b in args.baselines), *zip(labels, args.policy, strict=True)]
-    returns = {label: task_returns(policy, args.task, seeds).tolist() for label, policy in runs}
-    record = {"task": args.task, "seeds": list(seeds), "incumbent": args.incumbent,
+    returns = {label: task_returns(policy, task, seeds).tolist() for label, policy in runs}
+    record = {"task": task, "seeds": list(seeds), "incumbent": args.incumbent,
               "returns": returns}
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
