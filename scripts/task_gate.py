@@ -23,7 +23,7 @@ import argparse
 import json
 from pathlib import Path
 
-from aerostat_gym.agents.report import policy_labels
+from aerostat_gym.agents.report import given_labels, policy_labels
 from aerostat_gym.agents.returns import task_returns
 from aerostat_gym.agents.selection import GATE_SEEDS, task_gate
 from aerostat_gym.cli.common import run_script, script_description
@@ -52,9 +52,11 @@ def main(argv=None) -> dict:
                     help="the first N gate seeds (a smoke run)")
     ap.add_argument("--out", required=True, help="JSON file of the returns")
     args = ap.parse_args(argv)
-    labels = args.label or policy_labels(args.policy)
-    if len(labels) != len(args.policy):
-        raise SystemExit(f"--label gives {len(labels)} labels for {len(args.policy)} --policy")
+    try:
+        labels = (policy_labels(args.policy) if args.label is None
+                  else given_labels(args.label, args.policy))
+    except ValueError as err:
+        raise SystemExit(str(err)) from None
     if not 2 <= args.seeds <= len(GATE_SEEDS):
         raise SystemExit(f"--seeds must lie in [2, {len(GATE_SEEDS)}], got {args.seeds}")
     names = [*args.baselines, *labels]

@@ -197,6 +197,9 @@ def test_task_gate_script_writes_what_select_policy_reads(tmp_path, capsys, load
     with pytest.raises(ValueError, match=r"not a scripts/task_gate.py record: no \['incumbent', "
                                          r"'seeds', 'task'\]"):
         sel_script.read_gate([other])
+    with pytest.raises(SystemExit, match=r"--label: 1 label\(s\) for 2 --policy"):
+        gate_script.main(["--incumbent", "x", "--policy", "modal", "--policy", "lqr",
+                          "--label", "x", "--out", str(out)])
     with pytest.raises(SystemExit, match="--seeds must lie in"):
         gate_script.main(["--incumbent", "x", "--policy", "modal", "--seeds", "1",
                           "--out", str(out)])
