@@ -20,17 +20,21 @@ from .protocol_stats import bootstrap_mean_ci, paired_difference_ci
 RETURN_SEEDS = tuple(range(1000, 1020))
 
 
-def task_returns(policy_name: str, task_id: str, seeds=RETURN_SEEDS, params=None) -> np.ndarray:
-    """Episode return of ``policy_name`` (a baseline name, "shipped" or a .zip path) on each
-    seed of the task ``task_id``, one batched environment per seed."""
+def task_returns(policy_name, task_id: str, seeds=RETURN_SEEDS, params=None,
+                 env_kwargs=None) -> np.ndarray:
+    """Episode return of ``policy_name`` (a baseline name, "shipped", a .zip path, or a policy
+    object with SB3's ``predict``, used as it is) on each seed of the task ``task_id``, one
+    batched environment per seed; ``env_kwargs`` over the task's registered arguments, as a
+    training configuration's ``env_kwargs`` block sets them."""
     if task_id not in TASKS:
         raise ValueError(f"unknown task {task_id!r}; registered: {sorted(TASKS)}")
     seeds = [int(s) for s in seeds]
-    kwargs = dict(TASKS[task_id][0])
+    kwargs = {**TASKS[task_id][0], **(env_kwargs or {})}
     if params is not None:
         kwargs["params"] = params
     # a filtering baseline (the LQG) is designed for the task's sensor noise
-    policy = load_policy(policy_name, params=params, obs_noise=kwargs.get("obs_noise", 0.0))
+    policy = (policy_name if hasattr(policy_name, "predict") else
+              load_policy(policy_name, params=params, obs_noise=kwargs.get("obs_noise", 0.0)))
     env = TetheredAerostatVectorEnv(num_envs=len(seeds), observation="full", **kwargs)
     obs, _ = env.reset(seed=seeds)
     total, _ = rollout(policy, env, obs, MAX_EPISODE_STEPS)
