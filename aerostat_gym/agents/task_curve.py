@@ -8,7 +8,9 @@ training task, deterministic, on :data:`TASK_CURVE_SEEDS`, as a paired differenc
 run's starting point with its 95 % studentized interval. A residual run starts at a zero
 residual, so its starting point is its base controller through its command path
 (:func:`zero_residual`: for the shipped configuration, ``modal_lqg_shaped`` to the bit); any
-other run is compared with a named baseline (the braked winch by default).
+other run is compared with a named baseline (the braked winch by default). The return is the
+task's default reward, the one every policy is compared on, also for a run trained on the
+evaluator's score (``score_reward``).
 """
 
 from __future__ import annotations
