@@ -33,7 +33,8 @@ def record(policy, env, seed: int):
         o = np.asarray(obs, np.float32)[None, :]
         b, b_state = base.predict(o[:, :N_OBS], state=b_state, episode_start=start,
                                   deterministic=True)
-        mu, _ = policy.model.predict(policy.norm.normalize_obs(o), deterministic=True)
+        seen = o if policy.norm is None else policy.norm.normalize_obs(o)
+        mu, _ = policy.model.predict(seen, deterministic=True)
         bases.append(float(np.reshape(b, -1)[0]))
         means.append(float(np.reshape(mu, -1)[0]))
         a, filt = shaper(np.reshape(b, -1), np.reshape(mu, -1), filt, start)
@@ -62,6 +63,9 @@ def main(argv=None) -> int:
     policy = load_policy(args.policy)
     if getattr(policy, "residual", None) is None:
         raise SystemExit(f"{args.policy!r} is not a residual policy")
+    if policy.frame_stack > 1 or policy.recurrent or policy.observe_estimate:
+        raise SystemExit(f"{args.policy!r} stacks frames, is recurrent or reads the base's "
+                         "estimate: this study replays feed-forward residuals only")
     shaper = policy.residual[1]
     own = float(np.exp(policy.model.policy.log_std.detach().numpy()).reshape(-1)[0])
     env = gym.make(args.task)
