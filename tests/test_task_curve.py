@@ -75,7 +75,10 @@ def test_shipped_policy_starts_at_modal_lqg_shaped():
 def test_plain_model_has_no_zero_residual(tmp_path_factory):
     run = _run(tmp_path_factory, "plain", {}, timesteps=256)
     assert zero_residual(run / "ppo_final.zip") is None
-    assert task_curve(run, SEEDS)["reference"] == "passive"
+    curve = task_curve(run, SEEDS)
+    assert curve["reference"] == "passive"
+    assert curve["reference_mean"] == float(task_returns("passive", TASK, SEEDS,
+                                                         env_kwargs=ENV).mean())
 
 
 def test_bad_runs_are_refused(tmp_path, residual_run):
