@@ -22,22 +22,20 @@ FIRST_SEED = 1000
 
 def record(policy, env, seed: int):
     """(base commands, policy means) of one deterministic episode of ``policy`` (an SB3Policy
-    with a residual) on ``env``."""
-    from aerostat_gym.envs.spaces import N_OBS
+    with a residual) on ``env``: the policy's own step (:meth:`SB3Policy.command_parts`), its
+    two parts kept before they pass its command path."""
+    from aerostat_gym.agents.sb3io import policy_obs
 
-    base, shaper = policy.residual
+    shaper = policy.residual[1]
     obs, _ = env.reset(seed=seed)
-    b_state, filt, start = None, None, np.array([True])
+    state, start = None, np.array([True])
     bases, means = [], []
     while True:
-        o = np.asarray(obs, np.float32)[None, :]
-        b, b_state = base.predict(o[:, :N_OBS], state=b_state, episode_start=start,
-                                  deterministic=True)
-        seen = o if policy.norm is None else policy.norm.normalize_obs(o)
-        mu, _ = policy.model.predict(seen, deterministic=True)
+        b, mu, state, start = policy.command_parts(
+            policy_obs(policy, np.asarray(obs, np.float32)[None, :]), state, start)
         bases.append(float(np.reshape(b, -1)[0]))
-        means.append(float(np.reshape(mu, -1)[0]))
-        a, filt = shaper(np.reshape(b, -1), np.reshape(mu, -1), filt, start)
+        means.append(float(mu[0]))
+        a, state["filter"] = shaper(b, mu, state.get("filter"), start)
         start = np.array([False])
         obs, _, terminated, truncated, _ = env.step(a[0])
         if terminated or truncated:
@@ -63,9 +61,6 @@ def main(argv=None) -> int:
     policy = load_policy(args.policy)
     if getattr(policy, "residual", None) is None:
         raise SystemExit(f"{args.policy!r} is not a residual policy")
-    if policy.frame_stack > 1 or policy.recurrent or policy.observe_estimate:
-        raise SystemExit(f"{args.policy!r} stacks frames, is recurrent or reads the base's "
-                         "estimate: this study replays feed-forward residuals only")
     shaper = policy.residual[1]
     own = float(np.exp(policy.model.policy.log_std.detach().numpy()).reshape(-1)[0])
     env = gym.make(args.task)

@@ -177,13 +177,26 @@ class SB3Policy:
             return to_actions(np.asarray(a).reshape(-1), single), state
         check_state_passed(self, state, episode_start, len(obs), "the base controller's, the "
                            "command low-pass, the frame stack or the recurrent cells")
+        b, a, state, start = self.command_parts(obs, state, episode_start, deterministic)
+        if self.residual is not None:
+            a, state["filter"] = self.residual[1](b, a, state.get("filter"), start)
+            a = a[:, 0]
+        return to_actions(a, single), state
+
+    def command_parts(self, obs, state, episode_start, deterministic: bool = True):
+        """One step of everything before the command path, on a batch ``obs`` of the policy's
+        channels: (the base's command (N,) or None without a residual, the model's action (N,),
+        the state with the base's, the stack's and the recurrent cells' parts advanced, the
+        episode starts (N,) bool). :meth:`predict` sends the two through the residual's
+        :class:`CommandShaper`; the studies that replay the path read them apart."""
         n = len(obs)
         state = dict(state) if isinstance(state, dict) else {}
         start = (np.ones(n, bool) if episode_start is None and not state
                  else np.zeros(n, bool) if episode_start is None
                  else np.asarray(episode_start, bool).reshape(-1).copy())
+        b = None
         if self.residual is not None:  # the base reads the raw observation first, as in training
-            base, shaper = self.residual
+            base = self.residual[0]
             b, state["base"] = base.predict(obs[:, :N_OBS], state=state.get("base"),
                                             episode_start=start, deterministic=True)
             if self.observe_estimate:
@@ -206,11 +219,7 @@ class SB3Policy:
                                                   deterministic=deterministic)
         else:
             a, _ = self.model.predict(obs, deterministic=deterministic)
-        a = np.asarray(a, np.float64).reshape(-1)
-        if self.residual is not None:
-            a, state["filter"] = shaper(b, a, state.get("filter"), start)
-            a = a[:, 0]
-        return to_actions(a, single), state
+        return b, np.asarray(a, np.float64).reshape(-1), state, start
 
 
 def combine_residual(base_action, policy_action, scale: float) -> np.ndarray:

@@ -21,10 +21,9 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from ..params import as_params
-from .hyperparams import PROJECT_BLOCK
+from .hyperparams import load_hyperparams
 from .policies import load_policy
 from .protocol_stats import paired_difference_ci
 from .residual import ShapedPolicy
@@ -69,12 +68,12 @@ def run_task(run_dir) -> tuple[str, dict]:
     another aerostat than the baseline (its ``params.toml``) is refused: its starting point
     would need the base designed for that aerostat, which this curve does not build."""
     run = Path(run_dir)
-    task = json.loads((run / "training_summary.json").read_text())["task"]
+    algo = json.loads((run / "training_summary.json").read_text())["algo"]
     if as_params(run / "params.toml") != as_params(None):
         raise ValueError(f"{run} was trained on another aerostat than the baseline "
                          "(its params.toml); the task curve flies the baseline only")
-    config = yaml.safe_load((run / "hyperparams.yml").read_text()) or {}
-    return task, dict((config.get(PROJECT_BLOCK) or {}).get("env_kwargs") or {})
+    task, _, project = load_hyperparams(algo, run / "hyperparams.yml")
+    return task, dict(project.get("env_kwargs") or {})
 
 
 def zero_residual(model_path):
