@@ -6,7 +6,7 @@ jit_cache.refresh()  # before any compiled function loads its cache: see jit_cac
 
 from .registration import ENV_ID, register  # noqa: E402
 
-__version__ = "0.7.21"
+__version__ = "0.7.22"
 #: Oldest version whose registered tasks (dynamics, wind, reward, winch logic) and residual
 #: command path this version reproduces: a policy trained by it or later runs here as it was
 #: trained (0.5 added a baseline and stricter loading, 0.6 training options and an optional

@@ -30,6 +30,13 @@ TASKS: dict[str, tuple[dict, str]] = {
         "winch control in realistic conditions: 3-15 m/s, light turbulence (5 % intensity), an "
         "initial swing as in the damping task, the estimated parameters randomised per episode "
         "and the evaluation protocol's sensor noise (the shipped policy's task)"),
+    "TetheredAerostatRealisticWeathervaning-v0": (
+        {"turbulence": "light", "perturbation": "displacement", "randomize": True,
+         "weathercock": True, "obs_noise": 0.01},
+        "TetheredAerostatRealistic-v0 with every randomised aerostat weathercock-stable: a "
+        "draw whose static yaw moment does not restore at yaw offsets up to 10 deg is drawn "
+        "again (TetheredAerostatRealistic-v0 draws about 15 % that do not; in the light "
+        "turbulence they sail 80-200 m across the wind and hold most of its heavy tail)"),
 }
 
 

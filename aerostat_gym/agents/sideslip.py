@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..analysis.directional import static_yaw_acceleration
 from ..analysis.trim import find_equilibrium
 from ..envs.spaces import CHANNELS, OBS_WIND_X, OBS_WIND_Y, OBS_WIND_Z
 from ..envs.vector import TetheredAerostatVectorEnv
 from ..params import apply_overrides, load_params
 from ..physics.core import rotation_matrix
-from ..physics.state import S_PSI, S_R
 from ..sim import Model
 
 OFFSETS_DEG = (5, 10, 15, 20, 30, 45, 60, 75, 90)
@@ -35,14 +35,7 @@ def yaw_curve(wind_speed: float = 8.0, overrides: dict | None = None,
     """
     p = apply_overrides(params or load_params(), overrides or {})
     eq = find_equilibrium(p, wind_speed)
-    model = Model(p, wind=wind_speed)
-    lay = model.layout
-    out = []
-    for deg in offsets:
-        x = eq.x.copy()
-        x[lay.at(S_PSI)] += np.radians(deg)
-        out.append(float(model.rhs(x)[lay.at(S_R)]))
-    return out
+    return static_yaw_acceleration(Model(p, wind=wind_speed), eq.x, offsets).tolist()
 
 
 def sideslip(euler: np.ndarray, v_rel: np.ndarray) -> np.ndarray:

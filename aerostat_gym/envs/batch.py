@@ -29,6 +29,7 @@ from .episodes import (
     Episode,
     TrimTable,
     bank_decorrelation,
+    check_weathercock_draws,
     field_length_needed,
     sample_episode,
     unit_bank,
@@ -419,7 +420,8 @@ def held_wind_top(params: Params, lo: float, hi: float) -> float:
 def trim_table(task: TaskConfig) -> TrimTable:
     """The task's trim table, refused (TaskError) where the configured tether cannot hold the
     trim anywhere in the wind range, with a warning where the winch motor cannot (it then holds
-    on its brake: reel-in commands cannot be obeyed at those winds)."""
+    on its brake: reel-in commands cannot be obeyed at those winds); with ``weathercock=True``,
+    refused where nearly no randomised aerostat weathervanes."""
     params = task.params_resolved
     lo, hi = task.resolved["wind_speed"]
     try:
@@ -438,6 +440,7 @@ def trim_table(task: TaskConfig) -> TrimTable:
         warnings.warn(f"wind_speed up to {hi} m/s: from {first} m/s the trim tension exceeds "
                       f"winch.max_motor_force = {fmax:.0f} N; the winch holds on its brake "
                       "against reel-in commands there", stacklevel=3)
+    check_weathercock_draws(task, trims)
     return trims
 
 

@@ -114,6 +114,7 @@ class TaskConfig:
     params: object = None
     overrides: dict | None = None
     randomize: object = None
+    weathercock: bool = False
     obs_noise: float = 0.0
     reward_weights: dict | None = None
     reward_fn: object = None
@@ -165,6 +166,9 @@ class TaskConfig:
         r["turbulence_mix"] = turbulence_mix(self.turbulence_mix, r["turbulence"],
                                              self.turbulence)
         r["randomize"] = self._randomize(r["params"])
+        if not isinstance(self.weathercock, (bool, np.bool_)):
+            raise TaskError(f"weathercock must be True or False (redraw randomised aerostats "
+                            f"that do not weathervane), got {self.weathercock!r}")
 
     def _params(self) -> Params:
         p = as_params(self.params, TaskError)

@@ -183,6 +183,12 @@ class TetheredAerostatEnv(gym.Env):
       and uniform; moments of inertia no body has (a broken triangle inequality, about 11 % of
       the default draws) are drawn again, and inertia ranges that give bodies less than 5 % of
       the time are refused here.
+    - ``weathercock=False``: with ``randomize``, an aerostat that does not weathervane at its
+      episode's trim (its static yaw moment not restoring at every yaw offset of
+      ``aerostat_gym.analysis.directional.WEATHERCOCK_OFFSETS_DEG``, 2.5-10 deg) is drawn
+      again; refused here where under 5 % of the draws weathervane.
+      ``TetheredAerostatRealisticWeathervaning-v0`` sets it (0.7.22; v0 draws about 15 % that
+      do not, and they hold most of its heavy tail: docs/parameters.md 5.5).
     - ``obs_noise=0.0``: sensor noise std in scaled units. ``reward_weights=None``: dict of
       weights by term name. ``reward_fn=None``: a user reward ``f(obs, action, info) -> float``.
       ``observation="standard"`` or ``"full"``.

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.directional import WEATHERCOCK_OFFSETS_DEG, weathercock_stable
 from ..analysis.trim import Equilibrium, TrimError, find_equilibrium, largest_trim_tension
 from ..checks import is_number
 from ..params import InertiaError, ParameterError, Params, apply_overrides, dumps_toml
@@ -55,6 +56,14 @@ MAX_REDRAWS = 20
 #: a randomisation is made only where at least 5 % of the inertia draws are bodies, so 1000
 #: redraws all fail with probability below 0.95^1000 ~ 5e-23)
 MAX_INERTIA_REDRAWS = 1000
+#: further draws allowed, with ``weathercock=True``, for aerostats that do not weathervane
+#: (each costs a trim; the task is made only where at least MIN_WEATHERCOCK_ACCEPTANCE of the
+#: draws weathervane, so 1000 redraws all fail with probability below 0.95^1000)
+MAX_WEATHERCOCK_REDRAWS = 1000
+#: the smallest share of weathercock-stable draws a task with ``weathercock=True`` is made with
+MIN_WEATHERCOCK_ACCEPTANCE = 0.05
+#: draws per wind speed (the range's ends and middle) of the door's acceptance estimate
+WEATHERCOCK_ACCEPTANCE_DRAWS = 100
 
 
 # --- trims, shared between environments with the same parameters -------------------------------
@@ -105,7 +114,7 @@ class TrimTable:
             self.speeds = np.concatenate([ends[0], grid, ends[1]])
         on_grid = np.isin(self.speeds, grid)
         self.draws = np.flatnonzero(on_grid) if on_grid.any() else np.array([0])
-        key = (dumps_toml(params), tuple(self.speeds.tolist()))
+        self.key = key = (dumps_toml(params), tuple(self.speeds.tolist()))
         # winch-end tension (the winch's load) and the largest (the tether's, top end) per speed
         self.states, self.tensions, self.largest_tensions = _remembered(
             _TRIMS, key, lambda: _build_trims(params, self.speeds), MAX_CACHED_TRIMS)
@@ -321,7 +330,9 @@ def _parameters(task: TaskConfig, trims: TrimTable, U: float, rng) -> tuple[Para
     whose moments of inertia no body has (a triangle inequality broken, about 10 % of the
     default draws) is drawn again, so the episode's aerostat is uniform over the ranges'
     physical part. A draw that loads but does not trim is drawn again too, a bounded number of
-    times (:data:`MAX_REDRAWS`)."""
+    times (:data:`MAX_REDRAWS`). With ``weathercock=True`` so is a draw that does not weathervane
+    at its trim (:func:`~aerostat_gym.analysis.directional.weathercock_stable`): the episode's
+    aerostat is then uniform over the ranges' weathercock-stable part."""
     spec = task.resolved["randomize"]
     if not spec:
         k = trims.index(U)
@@ -331,21 +342,75 @@ def _parameters(task: TaskConfig, trims: TrimTable, U: float, rng) -> tuple[Para
             return trims.params, trims.off_grid_trim(U)
         except TrimError as exc:
             raise TaskError(f"wind_speed {U} m/s: no trim for these parameters: {exc}") from None
-    base = trims.params
     last = None
-    failures = no_body = 0
-    while failures < MAX_REDRAWS and no_body < MAX_INERTIA_REDRAWS:
-        over = {key: get_parameter(base, key) * (1.0 + rng.uniform(-rel, rel))
-                for key, rel in spec.items()}
+    failures = no_body = divergent = 0
+    while (failures < MAX_REDRAWS and no_body < MAX_INERTIA_REDRAWS
+           and divergent < MAX_WEATHERCOCK_REDRAWS):
         try:
-            params = apply_overrides(base, over)
-            return params, _continued_trim(params, trims, U)
+            params = _drawn(trims.params, spec, rng)
+            x_trim = _continued_trim(params, trims, U)
         except InertiaError as exc:
             no_body, last = no_body + 1, exc
+            continue
         except (ParameterError, TrimError) as exc:
             failures, last = failures + 1, exc
-    raise TaskError(f"randomize {spec} gave no feasible aerostat in {failures + no_body} draws "
-                    f"at U = {U} m/s (last: {last}); narrow the ranges")
+            continue
+        if not task.weathercock or weathercock_stable(Model(params, U), x_trim):
+            return params, x_trim
+        divergent, last = divergent + 1, "the static yaw moment does not restore"
+    raise TaskError(f"randomize {spec} gave no feasible aerostat in "
+                    f"{failures + no_body + divergent} draws at U = {U} m/s (last: {last}); "
+                    "narrow the ranges")
+
+
+def _drawn(base: Params, spec: Mapping[str, float], rng) -> Params:
+    """One draw of the randomised parameters: each uniform within its relative half-range."""
+    return apply_overrides(base, {key: get_parameter(base, key) * (1.0 + rng.uniform(-rel, rel))
+                                  for key, rel in spec.items()})
+
+
+def weathercock_acceptance(trims: TrimTable, spec: Mapping[str, float]) -> tuple[float, float]:
+    """(share, wind speed): the smallest share of weathercock-stable aerostats among
+    :data:`WEATHERCOCK_ACCEPTANCE_DRAWS` draws of ``spec`` at the table's lowest, middle and
+    highest speed, and the speed where it is smallest. Fixed seed; each draw is judged at the
+    nominal trim (the door's estimate; an episode judges a draw at its own trim); draws no body
+    can have are left out, as an episode start redraws them."""
+    rng = np.random.default_rng(0)
+    worst = (1.0, float(trims.speeds[0]))
+    for k in sorted({0, len(trims.speeds) // 2, len(trims.speeds) - 1}):
+        U, stable, bodies = float(trims.speeds[k]), 0, 0
+        for _ in range(WEATHERCOCK_ACCEPTANCE_DRAWS):
+            try:
+                params = _drawn(trims.params, spec, rng)
+            except ParameterError:
+                continue
+            bodies += 1
+            stable += weathercock_stable(Model(params, U), trims.states[k])
+        worst = min(worst, (stable / max(bodies, 1), U))
+    return worst
+
+
+def check_weathercock_draws(task: TaskConfig, trims: TrimTable) -> None:
+    """TaskError where ``weathercock=True`` would redraw nearly every randomised aerostat: fewer
+    than :data:`MIN_WEATHERCOCK_ACCEPTANCE` of the draws weathervane at some speed of the
+    range (measured once per parameter set, randomisation and range)."""
+    spec = task.resolved["randomize"]
+    if not (task.weathercock and spec):
+        return
+    key = (trims.key, tuple(sorted(spec.items())))
+    share, U = _remembered(_WEATHERCOCK, key, lambda: weathercock_acceptance(trims, spec),
+                           MAX_CACHED_TRIMS)
+    if share < MIN_WEATHERCOCK_ACCEPTANCE:
+        raise TaskError(
+            f"weathercock=True: only {100 * share:.1f} % of the draws of randomize {spec} "
+            f"weathervane at {U:g} m/s (their static yaw moment restores at yaw offsets up to "
+            f"{WEATHERCOCK_OFFSETS_DEG[-1]:g} deg); at least "
+            f"{100 * MIN_WEATHERCOCK_ACCEPTANCE:.0f} % must. Narrow the ranges of the fin lift "
+            "slope and the hull efficiency (fins.CL_alpha, hull.eta_k), or set weathercock=False")
+
+
+#: door estimates of the weathercock-stable share, by (trim table, randomisation)
+_WEATHERCOCK: dict = {}
 
 
 def _field(cfg, bank_shape, ua, wp, rng) -> tuple[int, float]:
