@@ -258,7 +258,7 @@ def test_suite_at_other_speeds_is_the_suite_cell_it_replaces():
     assert suite_cells("tiny", [18, 10]) == {"recover": ([10.0, 18.0], [0]),
                                             "gusty": ([10.0, 18.0], [100, 101])}
     assert "U = 10, 18 m/s; seeds 100, 101" in describe_suite("tiny", [10, 18])
-    for bad in ([], [5.0, 5.0], [float("nan")], [-1.0], ["x"]):
+    for bad in ([], [5.0, 5.0], [float("nan")], [-1.0], ["x"], [200.0]):
         with pytest.raises(ValueError, match="speeds"):
             suite_cells("tiny", bad)
     own = evaluate_policy("modal", "damping")
@@ -271,6 +271,8 @@ def test_suite_at_other_speeds_is_the_suite_cell_it_replaces():
     # the baselines' schedule covers 18 m/s (designed there, not clamped to 16 m/s)
     assert cells_wind_range(suite_cells("damping", [10.0, 18.0])) == (3.0, 18.0)
     assert schedule_speeds((3.0, 18.0))[-1] >= 18.0
+    # the modal table the run used (shared, so not rebuilt here) is designed up to 19 m/s
+    assert load_policy("modal", wind_range=(3.0, 18.0)).schedule.speeds[-1] == 19.0
     passive = evaluate_policy("passive", "damping", speeds=[18.0])
     assert new[18.0]["pendulum_zeta"] > 1.5 * passive["scenarios"]["recover"]["episodes"][0][
         "pendulum_zeta"]  # 0.85 against 0.39 when written

@@ -150,6 +150,38 @@ def test_load_policy_reads_a_single_wind_speed_as_the_task_does():
     assert load_policy("lqr", wind_range=5).schedule.speeds.tolist() == [4.0, 5.0, 6.0]
 
 
+def test_covering_speeds_keep_the_default_table_and_reach_above_the_range():
+    """The modal and LQG tables keep DEFAULT_SPEEDS (2-16 m/s) wherever they cover the range
+    (None: the default table, so the default ranges build what they always built) and continue
+    it in 1 m/s steps to one step above a higher top."""
+    from aerostat_gym.agents.scheduling import DEFAULT_SPEEDS, covering_speeds
+
+    for inside in ((3.0, 15.0), (3.0, 16.0), (0.0, 16.0), (5.0, 5.0)):
+        assert covering_speeds(inside) is None, inside
+    assert covering_speeds((20.0, 25.0)).tolist() == [float(u) for u in range(2, 27)]
+    assert covering_speeds((3.0, 16.5)).tolist() == [float(u) for u in range(2, 19)]
+    assert np.array_equal(covering_speeds((3.0, 18.0))[:DEFAULT_SPEEDS.size], DEFAULT_SPEEDS)
+
+
+@pytest.mark.parametrize("name", ["passive", "lqr", "modal_lqg", "shipped"])
+@pytest.mark.parametrize("noise", [-1.0, "x", float("nan")])
+def test_load_policy_refuses_a_bad_obs_noise_for_every_policy(name, noise):
+    """A baseline without a filter and a saved model (whose base filters at the noise it was
+    trained with) check ``obs_noise`` as the LQG does: at the door, naming it."""
+    with pytest.raises(PolicyError, match=re.escape(f"obs_noise must be a finite number >= 0, "
+                                                    f"got {noise!r}")):
+        load_policy(name, obs_noise=noise)
+
+
+def test_evaluate_names_the_speeds_given_when_one_is_too_high(capsys):
+    """``--speeds 200``: the message names --speeds and the 200 given, not the scheduling
+    range (3, 200) built from it; the limit is MAX_WIND_SPEED = 100 m/s."""
+    assert main(["evaluate", "--policy", "passive", "--speeds", "200", "--no-plots"]) == 2
+    assert capsys.readouterr().err == ("aerostat-gym evaluate: error: --speeds: speeds must be "
+                                       "finite wind speeds in [0, 100] m/s without repeats, "
+                                       "got [200.0]\n")
+
+
 # --- D8: the SB3 adapter -----------------------------------------------------------------------
 
 def test_sb3_adapter_passes_set_options_to_the_next_reset_only():

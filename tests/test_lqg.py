@@ -20,8 +20,11 @@ from aerostat_gym.agents.lqg import (
     design_lqg,
     measurement_noise,
 )
+from aerostat_gym.agents.policies import load_policy
+from aerostat_gym.agents.sb3io import read_wrappers
 from aerostat_gym.envs.spaces import CHANNELS, N_OBS
 from aerostat_gym.params import load_params
+from aerostat_gym.resources import SHIPPED_POLICY, shipped_path
 from aerostat_gym.sim import Model
 
 DT = 0.2
@@ -228,3 +231,26 @@ def test_estimate_features_filter_the_sensor_noise(params, modal_schedule):
     for name in ("dx", "dz", "dlength"):
         i = list(MEASURED).index(name)
         assert rms_est[i] <= rms_meas[i] / 3, (name, rms_est[i])
+
+
+def test_modal_lqg_and_the_shipped_base_are_designed_up_to_the_wind_range(params):
+    """wind_range=(20, 25) continues the default 2-16 m/s table to 26 m/s (the baseline's
+    motor holds the trim to 26 m/s): at 25 m/s the gains are the design at 25 m/s, to the last
+    bit, not the 16 m/s ones clamped (40 % apart in norm when written), and inside 2-16 m/s the
+    table is the default's row for row. The shipped residual's base (modal_lqg at the noise it
+    was trained with) gets the same table."""
+    noise = read_wrappers(shipped_path(SHIPPED_POLICY))["residual"]["obs_noise"]
+    high = load_policy("modal_lqg", wind_range=(20, 25), obs_noise=noise).schedule
+    default = load_policy("modal_lqg", obs_noise=noise).schedule
+    assert high.speeds.tolist() == [float(u) for u in range(2, 27)]
+    assert load_policy("modal_lqg", wind_range=(3, 16), obs_noise=noise).schedule is default
+    for k in default.tables:
+        assert np.array_equal(high.tables[k][:default.speeds.size], default.tables[k]), k
+    U = np.array([25.0])
+    k25, k16 = high.lookup(U, ["K"])["K"][0], default.lookup(U, ["K"])["K"][0]
+    reference = design_lqg(params, 25.0, DT, noise, gains="modal").K
+    assert np.max(np.abs(k25 - reference)) <= 1e-9 * np.max(np.abs(reference))
+    assert np.array_equal(k16, default.tables["K"][-1])
+    assert np.linalg.norm(k25 - k16) > 0.2 * np.linalg.norm(k16)
+    base = load_policy("shipped", wind_range=(20, 25)).residual[0]
+    assert base.schedule is high

@@ -57,6 +57,7 @@ from aerostat_gym.analysis.sensitivity import (
 from aerostat_gym.analysis.trim import TrimError, find_equilibrium
 from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main
+from aerostat_gym.cli.agents import demo_summary
 from aerostat_gym.cli.stability import held_speeds
 from aerostat_gym.envs.batch import held_wind_top
 from aerostat_gym.envs.config import PERTURBATIONS, TaskConfig, TaskError
@@ -348,6 +349,61 @@ def test_family_sweep_ends_where_a_member_has_no_trim():
         wind_sweep(p, speeds)
     sweep = wind_sweep(p, speeds, stop_without_trim=True)
     assert sweep.values.tolist() == speeds[:15].tolist() and len(sweep.analyses) == 15
+    assert "no equilibrium found at U = 14" in str(sweep.stop_error)
+
+
+@pytest.fixture(scope="module")
+def fins_forward(tmp_path_factory):
+    """The baseline with its fins' centres of pressure mirrored ahead of the CM (x = +5.715 m):
+    directionally unstable, and with no trim the solver finds from 16.156 m/s."""
+    data = tomllib.loads(dumps_toml(load_params()))
+    for panel in data["fins"]["panels"]:
+        panel["cp_position"][0] = -panel["cp_position"][0]
+    path = tmp_path_factory.mktemp("finsfwd") / "finsfwd.toml"
+    path.write_text(dumps_toml(params_from_dict(data)))
+    return path
+
+
+def test_stability_sweep_stops_where_the_trim_fails(capsys, fins_forward):
+    """Fins ahead of the CM: ``stability --wind 1:21:5`` has no trim at 21 m/s (the continuation
+    stalls at 16.156 m/s); it reports the speeds that trim, 1-16 m/s, with the divergent yaw
+    (lambda = +1.388 1/s at 16 m/s, +1.155 at 11 m/s: a real root, Re > 0), warns where and
+    why it stopped, and puts the stop into --json (it used to print only the trim error and
+    exit 2). With no speed that trims the trim error stays."""
+    capsys.readouterr()
+    assert main(["stability", "--config", str(fins_forward), "--wind", "1:21:5", "--json"]) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert sorted({row["wind_speed_m_s"] for row in out["modes"]}) == [1.0, 6.0, 11.0, 16.0]
+    stop = out["stop"]
+    assert (stop["last_wind_speed_m_s"], stop["failed_wind_speed_m_s"]) == (16.0, 21.0)
+    assert stop["reason"].startswith("no trim at 21 m/s: no equilibrium found at U = 16.156 m/s")
+    assert "the sweep stops at 16 m/s: no trim at 21 m/s" in captured.err
+    assert out["all_stable"] is False
+    yaw = next(u for u in out["unstable_modes"] if u["set"] == "lat" and u["label"] == "yaw")
+    assert yaw["wind_speeds_m_s"] == [1.0, 6.0, 11.0, 16.0] and yaw["eigenvalue_im"] == 0.0
+    assert yaw["worst_wind_speed_m_s"] == 16.0
+    assert yaw["eigenvalue_re"] == pytest.approx(1.388, abs=0.005)
+    text = _run(capsys, ["stability", "--config", str(fins_forward), "--wind", "11:21:10"])
+    assert "UNSTABLE lateral yaw at U = 11 m/s; fastest at 11 m/s: lambda = +1.155 1/s" in text
+    assert text.rstrip().splitlines()[-1].startswith("the sweep stops at 11 m/s: no trim at 21")
+    assert main(["stability", "--config", str(fins_forward), "--wind", "17:20:1"]) == 2
+    assert "error: no equilibrium found at U = 16.156 m/s" in capsys.readouterr().err
+
+
+def test_demo_summary_names_every_unstable_mode(fins_forward):
+    """At 10 m/s with the fins ahead of the CM the five listed modes are all damped; the
+    summary's "all modes stable = False" is the divergent yaw, now listed with lambda =
+    +1.075 1/s and the time its amplitude takes to double, ln 2 / lambda = 0.645 s. The
+    baseline lists no unstable mode."""
+    lines = demo_summary(load_params(fins_forward), 10.0, "finsfwd")
+    assert "  linear stability: all modes stable = False" in lines
+    unstable = [line.split() for line in lines if "UNSTABLE" in line]
+    assert [words[1:3] for words in unstable] == [["lateral", "yaw"]]
+    lam, doubling = float(unstable[0][5]), float(unstable[0][9])
+    assert lam == pytest.approx(1.075, abs=0.005)
+    assert doubling == pytest.approx(math.log(2.0) / lam, rel=2e-3)
+    assert not any("UNSTABLE" in line for line in demo_summary(load_params(), 10.0))
 
 
 def test_params_provenance(case, capsys):

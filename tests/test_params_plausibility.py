@@ -546,3 +546,192 @@ def test_a_misspelt_status_word_warns_naming_the_line(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         load_params()
+
+
+# --- mass, radii of gyration, trim pitch and wind profile (audit 0.7.19) ---------------------------
+
+POWER = BASE.replace(**{"wind.profile": "power"})
+LOG = BASE.replace(**{"wind.profile": "log"})
+
+
+def _inertias(factor: float, base=BASE) -> dict:
+    """The four moments of inertia times a factor (a whole file in g m^2 or t m^2)."""
+    a = base.aerostat
+    return {f"aerostat.{k}": getattr(a, k) * factor for k in ("Ixx", "Iyy", "Izz", "Ixz")}
+
+
+#: (base, section, key, value, texts the ImplausibleParameterError must contain)
+PROFILE_AND_MASS_REFUSED = [
+    # 1 g for the 519 m^3 hull: 0.001 / (1.147 * 519 = 595.3 kg of air) = 1.68e-6 < 0.05
+    (BASE, "aerostat", "mass", 0.001, ("aerostat.mass = 0.001 kg is 1.68e-06 of the 595.3 kg of "
+                                       "air the hull displaces", "below 0.05")),
+    # the baseline's 325.7 kg written in tonnes: 5.47e-4 of the displaced air
+    (BASE, "aerostat", "mass", 0.3257, ("aerostat.mass = 0.3257 kg is 0.000547",
+                                        "looks like tonnes written as kg")),
+    # the winch at z = 0 and 300 m of tether: (300 / 10)^3 = 2.7e4 at the aerostat
+    (POWER, "wind", "shear_exponent", 3.0, ("wind.shear_exponent = 3 exceeds 1 for wind.profile "
+                                            "= 'power'", "2.7e+04-fold", "about 300 m")),
+    (POWER, "wind", "shear_exponent", 14.0, ("wind.shear_exponent = 14 exceeds 1",
+                                             "looks like a percentage written as a fraction")),
+    # ln(300 / 9) / ln(10 / 9) = 3.5066 / 0.10536 = 33.28
+    (LOG, "wind", "roughness_length", 9.0, ("wind.roughness_length = 9 m exceeds 5 m for "
+                                            "wind.profile = 'log'", "33.3-fold",
+                                            "looks like cm written as m")),
+]
+
+
+@pytest.mark.parametrize("base, section, key, value, texts", PROFILE_AND_MASS_REFUSED,
+                         ids=[f"{c[2]}={c[3]!r}" for c in PROFILE_AND_MASS_REFUSED])
+def test_mass_and_profile_slips_are_refused_in_a_file_and_as_overrides(tmp_path, base, section,
+                                                                        key, value, texts):
+    f = tmp_path / "slip.toml"
+    f.write_text(_set_in_toml(dumps_toml(base), section, key, repr(value)))
+    own = tmp_path / "own.toml"
+    own.write_text(dumps_toml(base))
+    for load in (lambda: load_params(f), lambda: load_params(own, {f"{section}.{key}": value})):
+        with pytest.raises(ImplausibleParameterError) as err:
+            load()
+        for t in texts:
+            assert t in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize("over, texts", [
+    # all four moments in g m^2: k_x = sqrt(3.135e6 / 325.7) = 98.11 m = 12.7 D (bound 2 D)
+    (_inertias(1e3), ("aerostat.Ixx = 3.135e+06 kg m^2 gives a radius of gyration "
+                      "sqrt(aerostat.Ixx / aerostat.mass) = 98.11 m, 12.7 x aerostat.diameter "
+                      "= 7.7 m, outside [0.02, 2]", "looks like g m^2 written as kg m^2")),
+    # in t m^2: k_x = sqrt(3.135 / 325.7) = 0.09811 m = 0.0127 D (bound 0.02 D)
+    (_inertias(1e-3), ("aerostat.Ixx = 3.135 kg m^2", "= 0.09811 m, 0.0127 x aerostat.diameter",
+                       "looks like t m^2 written as kg m^2")),
+    # a body (|Izz - Ixx| <= Iyy <= Ixx + Izz) with k_x 0.80 D but k_y = sqrt(149740 / 325.7)
+    # = 21.44 m = 1.17 L (bound 1 L)
+    ({"aerostat.Ixx": 12540.0, "aerostat.Iyy": 149740.0, "aerostat.Izz": 149740.0},
+     ("aerostat.Iyy = 149740 kg m^2", "= 21.44 m, 1.17 x aerostat.length = 18.3 m, outside "
+                                      "[0.02, 1]")),
+    # a needle: k_x = sqrt(20 / 325.7) = 0.032 D passes, k_y = sqrt(18.7 / 325.7) = 0.013 L
+    ({"aerostat.Ixx": 20.0, "aerostat.Iyy": 18.7, "aerostat.Izz": 18.7, "aerostat.Ixz": 0.0},
+     ("aerostat.Iyy = 18.7 kg m^2", "0.0131 x aerostat.length")),
+])
+def test_inertias_no_aerostat_has_are_refused(over, texts):
+    with pytest.raises(ImplausibleParameterError) as err:
+        load_params(overrides=over)
+    for t in texts:
+        assert t in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize("over, texts", [
+    # 100 / 595.3 = 0.168 < 0.25
+    ({"aerostat.mass": 100.0}, ("aerostat.mass = 100 kg is 0.168 of the air",)),
+    # k_x = 0.4029 * sqrt(10) = 1.27 D > 0.75 D, k_y = 0.262 * sqrt(10) = 0.829 L > 0.5 L
+    (_inertias(10.0), ("aerostat.Ixx = 31350 kg m^2 gives a radius of gyration of 1.27 x "
+                       "aerostat.diameter", "aerostat.Iyy = 74870 kg m^2 gives a radius of "
+                       "gyration of 0.829 x aerostat.length")),
+    # k_x = 0.4029 / sqrt(50) = 0.057 D < 0.1 D, k_z = 0.2552 / sqrt(50) = 0.0361 L < 0.06 L
+    (_inertias(0.02), ("gyration of 0.057 x aerostat.diameter",
+                       "aerostat.Izz = 142.06 kg m^2 gives a radius of gyration of 0.0361 x "
+                       "aerostat.length")),
+    ({"aerostat.trim_pitch_deg": 60.0}, ("aerostat.trim_pitch_deg = 60 deg (negative = nose up)",
+                                         "outside [-20, 10] deg")),
+    ({"aerostat.trim_pitch_deg": -30.0}, ("aerostat.trim_pitch_deg = -30 deg",)),
+    # 30^0.6 = 7.70: the audit's 10 m/s at 10 m is 77 m/s at 300 m
+    ({"wind.profile": "power", "wind.shear_exponent": 0.6},
+     ("wind.shear_exponent = 0.6 is steeper", "7.7-fold")),
+    # ln(300 / 3) / ln(10 / 3) = 4.605 / 1.204 = 3.825; 3 cm written as 3 m
+    ({"wind.profile": "log", "wind.roughness_length": 3.0},
+     ("wind.roughness_length = 3 m is rougher", "3.82-fold", "looks like cm written as m")),
+])
+def test_unusual_mass_inertia_pitch_and_profile_warn(over, texts):
+    with pytest.warns(ParameterWarning) as record:
+        load_params(overrides=over)
+    text = " | ".join(str(w.message) for w in record)
+    for t in texts:
+        assert t in text, text
+
+
+@pytest.mark.parametrize("over", [
+    {"wind.profile": "power", "wind.shear_exponent": 0.5},  # the warning's edge (cities 0.4)
+    {"wind.profile": "power", "wind.shear_exponent": 0.1},  # open sea
+    {"wind.profile": "log", "wind.roughness_length": 2.0},  # the warning's edge (city centres)
+    {"wind.profile": "log", "wind.roughness_length": 1e-5},  # calm sea
+    {"wind.profile": "uniform", "wind.shear_exponent": 3.0,  # unused by the uniform profile
+     "wind.roughness_length": 9.0},
+    {"aerostat.trim_pitch_deg": -20.0}, {"aerostat.trim_pitch_deg": 10.0},
+    {"aerostat.mass": 0.25 * 1.147 * 519.0 + 0.01},  # the mass warning's edge (148.8 kg)
+    _inertias(0.1), _inertias(1.9),  # the ends of a +-90 % randomisation of the inertias
+])
+def test_real_mass_inertia_pitch_and_profiles_load_without_warnings(over):
+    p = _load_quietly(overrides=over)
+    for key, value in over.items():
+        section, name = key.split(".")
+        got = getattr(getattr(p, section), name)
+        assert got == value if isinstance(value, str) else got == pytest.approx(value, rel=1e-12)
+
+
+@pytest.mark.parametrize("p", [BASE, load_params("tcom_32m")]
+                         + [scale_aerostat(BASE, f, 300.0, 5, -6.0) for f in (0.1, 10 ** -2.5, 10.0)],
+                         ids=["baseline", "tcom_32m", "0.1x", "0.003x", "10x"])
+def test_shipped_and_scaled_aerostats_sit_inside_the_mass_and_gyration_warnings(p):
+    """Mass 0.547 of the displaced air (warning below 0.25, refused below 0.05); radii of
+    gyration k_x 0.403 D (warning outside 0.1-0.75), k_y 0.262 L and k_z 0.255 L (0.06-0.5):
+    geometric scaling (mass s^3, inertia s^5) keeps each ratio."""
+    from aerostat_gym.params import gyration_radii, mass_ratio, plausibility_warnings
+
+    assert mass_ratio(p) == pytest.approx(0.5471, abs=2e-4)
+    radii = {key: k for key, _, k, *_ in gyration_radii(p)}
+    assert radii == pytest.approx({"aerostat.Ixx": 0.4029, "aerostat.Iyy": 0.2620,
+                                   "aerostat.Izz": 0.2552}, abs=2e-4)
+    assert plausibility_warnings(p) == []
+
+
+def test_the_env_refuses_a_profile_no_boundary_layer_has():
+    """gym.make's overrides and a Params built by replace() meet the profile bounds (replace
+    itself lets a study move past them, as for every plausibility bound)."""
+    import gymnasium as gym
+
+    import aerostat_gym  # noqa: F401  (registers the tasks)
+    over = {"wind.profile": "power", "wind.shear_exponent": 3.0}
+    assert BASE.replace(**over).wind.shear_exponent == 3.0
+    for make in (lambda: gym.make("TetheredAerostat-v0", overrides=over),
+                 lambda: gym.make("TetheredAerostat-v0", params=BASE.replace(**over))):
+        with pytest.raises(ImplausibleParameterError, match=r"wind\.shear_exponent = 3 exceeds 1"):
+            make()
+
+
+def test_an_over_tension_in_a_sheared_wind_names_the_speed_at_the_aerostat():
+    """The audit's case: 10 m/s at 10 m with alpha = 0.6 (a warning) breaks the tether at about
+    80 m/s at the aerostat; the message names that speed, its height and the profile (it said
+    only "at U = 10 m/s"). The speed is 10 (z / 10)^0.6 at the trimmed height z."""
+    from aerostat_gym.analysis.trim import TrimLimitError, limit_warnings
+
+    with pytest.warns(ParameterWarning, match="wind.shear_exponent = 0.6"):
+        p = load_params(overrides={"wind.profile": "power", "wind.shear_exponent": 0.6})
+    eq = find_equilibrium(p, 10.0)
+    z = eq.summary["aerostat_position_m"][2]
+    with pytest.raises(TrimLimitError) as err:
+        limit_warnings(p, eq.summary)
+    m = re.search(r"at U = 10 m/s at wind\.reference_height = 10 m \(([\d.]+) m/s at the "
+                  r"aerostat's height of (\d+) m: wind\.profile = 'power', "
+                  r"wind\.shear_exponent = 0\.6\) the trim tension \d+ N exceeds tether\.strength",
+                  str(err.value))
+    assert m, str(err.value)
+    assert float(m.group(1)) == pytest.approx(10.0 * (z / 10.0) ** 0.6, rel=1e-3)
+    assert float(m.group(1)) == pytest.approx(80.1, abs=0.5)
+    assert float(m.group(2)) == pytest.approx(z, abs=0.5)
+
+
+def test_a_stalled_trim_in_a_sheared_wind_names_the_speed_at_the_aerostat():
+    """alpha = 1 (the refusal's edge, a warning) stalls the continuation near 5.2 m/s at 10 m,
+    about 300 m/s at the stretched tether's top: the message names that speed (U z / 10 at the
+    last equilibrium's height z) and the profile (it said only "at U = 5.188 m/s")."""
+    with pytest.warns(ParameterWarning, match="wind.shear_exponent = 1 is steeper"):
+        p = load_params(overrides={"wind.profile": "power", "wind.shear_exponent": 1.0})
+    with pytest.raises(TrimError) as err:
+        find_equilibrium(p, 10.0)
+    m = re.search(r"no equilibrium found at U = ([\d.]+) m/s at wind\.reference_height = 10 m "
+                  r"\(([\d.]+) m/s at the aerostat's height of (\d+) m: wind\.profile = 'power', "
+                  r"wind\.shear_exponent = 1\) \(continuing from", str(err.value))
+    assert m, str(err.value)
+    u, v, z = (float(g) for g in m.groups())
+    assert u == pytest.approx(5.19, abs=0.05)
+    assert v == pytest.approx(u * z / 10.0, rel=2e-3)
+    assert v > MAX_WIND_SPEED

@@ -18,6 +18,7 @@ from aerostat_gym.agents.hyperparams import load_hyperparams
 from aerostat_gym.analysis.sensitivity import DAMPING_SPEEDS, default_knobs
 from aerostat_gym.analysis.sensitivity import stability_figures as sensitivity_evaluate
 from aerostat_gym.cli import main
+from aerostat_gym.cli.scale import format_summary
 from aerostat_gym.envs.config import DEFAULT_RANDOMIZATION
 from aerostat_gym.extras import MissingExtraError, require
 from aerostat_gym.params import ParameterError, load_params
@@ -229,6 +230,44 @@ def test_summary_of_a_known_study():
     assert s["periods_s"][PERIOD_KEYS[0]]["p50"] == pytest.approx(0.5)
     assert s["mode_instabilities"][0]["samples_unstable"] == 3
     assert s["mode_instabilities"][0]["speeds_m_s"] == [1.0]
+    r = np.corrcoef(x, x < 0.3)[0, 1]  # every sweep complete: the line as it always read
+    assert f"{first}: 3 sets, at 1 speeds in 1-1 m/s; follows x (r {r:+.2f})" in format_summary(s)
+
+
+def _study_with_failed_sweeps():
+    """Four sets on two speeds: the first mode unstable at 1 m/s in sets 0 and 1, whose trims
+    fail at 2 m/s (nan there), stable in the two complete sets 2 and 3."""
+    samples = []
+    for k in range(4):
+        stable = np.ones((2, len(MODES)))
+        if k < 2:
+            stable[0, 0], stable[1] = 0.0, np.nan
+        samples.append(SampleResult(np.array([0.1 * k]), stable, np.full((2, len(MODES)), 0.1),
+                                    np.full((2, len(MODES)), 10.0), stable.min(axis=1),
+                                    np.array([0.01 if k < 2 else -0.01, -0.02]),
+                                    np.zeros(len(PERIOD_KEYS)),
+                                    "trim failed: no equilibrium" if k < 2 else ""))
+    return Study(["x"], [(0.0, 1.0)], [0.5], np.array([1.0, 2.0]), 0, samples, "serial", 1.0)
+
+
+def test_mode_instabilities_count_as_the_probability_table_does():
+    """Two of four sets are unstable in the first mode at 1 m/s and then fail to trim: the
+    probability table gives P(stable) = 2/4 there, and the mode's summary counts the same 2
+    sets (it counted only the complete sweeps, 0); its correlation, over the 2
+    complete sweeps that are both stable, is undefined, which the text says instead of
+    printing "follows None (r +nan)"."""
+    s = summarize(_study_with_failed_sweeps())
+    first = f"{MODES[0][0]} {MODES[0][1]}"
+    row = next(r for r in s["stability"] if r["mode"] == first and r["wind_speed_m_s"] == 1.0)
+    assert (row["n"], row["p_stable"]) == (4, 0.5)
+    m = s["mode_instabilities"][0]
+    assert (m["samples_unstable"], m["complete"], m["complete_unstable"]) == (2, 2, 0)
+    assert m["speeds_m_s"] == [1.0] and m["top_parameter"] is None and math.isnan(m["r"])
+    assert m["no_r"] == "0 of the 2 complete sweeps are unstable in it (r needs both outcomes)"
+    text = format_summary(s)
+    assert f"unstable {first}: 2 of 4 sets (failed sweeps counted up to where they failed)" in text
+    assert "None" not in text and "nan" not in text
+    assert "no parameter named: 0 of the 2 complete sweeps are unstable in it" in text
 
 
 # --- serial and Ray paths ---------------------------------------------------------------------------------

@@ -53,7 +53,7 @@ from ..envs.batch import held_wind_top
 from ..envs.config import DEFAULT_WIND_RANGE, check_control_step
 from ..envs.spaces import REFERENCE_TETHER_LENGTH, displacement_scale
 from ..envs.vector import TetheredAerostatVectorEnv
-from ..params import Params, as_params, dumps_toml
+from ..params import MAX_WIND_SPEED, Params, as_params, dumps_toml
 from ..physics.state import S_Q, S_THETA, S_X, S_Y
 from .fit_guides import guide_kwargs, guides_for, screen_fits
 from .metrics import response_metrics
@@ -184,8 +184,9 @@ def suite_seeds(name: str) -> set:
 
 def suite_cells(name: str, speeds=None) -> dict:
     """A suite's cells ({scenario: (speeds, seeds)}); with ``speeds`` (mean wind speeds [m/s],
-    finite, >= 0, no repeats) every scenario runs at those speeds instead, on the suite's own
-    seeds, sensor noise and durations: the suite's scenarios at the winds of your site."""
+    finite, in [0, MAX_WIND_SPEED], no repeats) every scenario runs at those speeds instead, on
+    the suite's own seeds, sensor noise and durations: the suite's scenarios at the winds of
+    your site."""
     cells = check_suite(name)
     if speeds is None:
         return cells
@@ -193,10 +194,10 @@ def suite_cells(name: str, speeds=None) -> dict:
         us = sorted(float(u) for u in speeds)
     except (TypeError, ValueError):
         raise ValueError(f"speeds must be numbers [m/s], got {speeds!r}") from None
-    if not us or not all(math.isfinite(u) and u >= 0.0 for u in us) \
+    if not us or not all(math.isfinite(u) and 0.0 <= u <= MAX_WIND_SPEED for u in us) \
             or len(set(us)) != len(us):
-        raise ValueError(f"speeds must be finite wind speeds >= 0 m/s without repeats, got "
-                         f"{list(speeds)!r}")
+        raise ValueError(f"speeds must be finite wind speeds in [0, {MAX_WIND_SPEED:g}] m/s "
+                         f"without repeats, got {list(speeds)!r}")
     return {sc: (us, seeds) for sc, (_, seeds) in cells.items()}
 
 

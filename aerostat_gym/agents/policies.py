@@ -41,7 +41,7 @@ from .lqr import LQRPolicy, LQRSchedule
 from .modal import ModalPolicy, ModalSchedule
 from .residual import ShapedPolicy, check_residual, residual_shaper
 from .sb3io import PolicyError, load_sb3, to_actions
-from .scheduling import schedule_speeds
+from .scheduling import covering_speeds, schedule_speeds
 
 BASELINES = ("passive", "tension", "lqr", "modal", "lqg", "modal_lqg", "modal_lqg_shaped",
              "modal_lqg_lowpass")
@@ -154,8 +154,8 @@ SCHEDULE_CACHE_SIZE = 16
 @lru_cache(maxsize=SCHEDULE_CACHE_SIZE)
 def default_schedule(kind: str, params: Params, dt: float, speeds: tuple | None = None,
                      obs_noise: float = 0.0):
-    """The default design table of a model-based baseline: ``kind`` "lqr" (:class:`LQRSchedule`
-    over ``speeds``, None for its default speeds), "modal" (:class:`ModalSchedule`) or
+    """The default design table of a model-based baseline over ``speeds`` (None: the default
+    speeds): ``kind`` "lqr" (:class:`LQRSchedule`), "modal" (:class:`ModalSchedule`) or
     "lqg" / "modal_lqg" (:class:`LQGSchedule` with the LQR's or the modal gains, filters for
     ``obs_noise``).
 
@@ -167,8 +167,8 @@ def default_schedule(kind: str, params: Params, dt: float, speeds: tuple | None 
     if kind == "lqr":
         return LQRSchedule(params, speeds=speeds, dt=dt)
     if kind == "modal":
-        return ModalSchedule(params, dt=dt)
-    return LQGSchedule(params, dt=dt, obs_noise=obs_noise,
+        return ModalSchedule(params, speeds=speeds, dt=dt)
+    return LQGSchedule(params, speeds=speeds, dt=dt, obs_noise=obs_noise,
                        gains="modal" if kind == "modal_lqg" else "lqr")
 
 
@@ -187,14 +187,23 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     shipped residual's command path without the learning), 'modal_lqg_lowpass' (the same
     low-pass without the deadband).
 
+    ``wind_range`` (low, high) [m/s] is the range the scheduled designs cover: 'lqr' designs
+    over it (:func:`~aerostat_gym.agents.scheduling.schedule_speeds`); the modal and LQG
+    designs, and a saved residual's base, keep the default 2-16 m/s table and continue it up
+    to a higher top (:func:`~aerostat_gym.agents.scheduling.covering_speeds`).
+
     A saved model's wrapper metadata (``<stem>_wrappers.json``) is honoured: its frame stack,
     and its residual base rebuilt for ``params`` and ``dt`` with the sensor noise it was
-    trained with. The model-based baselines' design tables come from :func:`default_schedule`:
-    built once per process for the same inputs and shared, read-only.
+    trained with (``obs_noise`` is checked, but the base's filter is the trained one). The
+    base is designed for ``params``, not for the aerostat the policy later flies: to fly
+    'shipped' or a residual model on another aerostat, pass that aerostat's ``params`` here.
+    The model-based baselines' design tables come from :func:`default_schedule`: built once per
+    process for the same inputs and shared, read-only.
     """
     params = as_params(params, PolicyError)
     check_control_step(dt)  # the step the controllers are designed for
     wind_range = _wind_range(wind_range)
+    obs_noise = check_obs_noise(obs_noise, PolicyError)
     if isinstance(name, os.PathLike):
         name = os.fspath(name)
     if not isinstance(name, str):
@@ -214,12 +223,14 @@ def load_policy(name: str, params=None, dt: float = 0.2, wind_range=None,
     if name == "lqr":
         speeds = None if wind_range is None else tuple(schedule_speeds(wind_range))
         return LQRPolicy(params, dt=dt, schedule=default_schedule("lqr", params, float(dt), speeds))
+    speeds = _covering(wind_range)
     if name == "modal":
-        return ModalPolicy(params, dt=dt, schedule=default_schedule("modal", params, float(dt)))
+        return ModalPolicy(params, dt=dt,
+                           schedule=default_schedule("modal", params, float(dt), speeds))
     if name in ("lqg", "modal_lqg"):
-        return _lqg(name, params, dt, obs_noise)
+        return _lqg(name, params, dt, obs_noise, speeds)
     if name in ("modal_lqg_shaped", "modal_lqg_lowpass"):
-        return shaped_command(_lqg("modal_lqg", params, dt, obs_noise), dt,
+        return shaped_command(_lqg("modal_lqg", params, dt, obs_noise, speeds), dt,
                               SHAPED_DEADBAND if name == "modal_lqg_shaped" else 0.0)
     if name in SHIPPED:
         return load_sb3(shipped_path(SHIPPED[name]), residual_factory)
@@ -252,8 +263,16 @@ def _wind_range(value) -> tuple[float, float] | None:
         raise PolicyError(str(exc)) from None
 
 
-def _lqg(kind: str, params: Params, dt: float, obs_noise) -> LQGPolicy:
-    """An LQG baseline ("lqg" or "modal_lqg") on the shared table for its sensor noise."""
-    noise = check_obs_noise(obs_noise)
-    return LQGPolicy(params, dt=dt, obs_noise=noise,
-                     schedule=default_schedule(kind, params, float(dt), None, noise))
+def _covering(wind_range) -> tuple | None:
+    """The design speeds of the modal and LQG tables for a checked ``wind_range`` (None: the
+    default table, also wherever it covers the range; see :func:`covering_speeds`)."""
+    speeds = None if wind_range is None else covering_speeds(wind_range)
+    return None if speeds is None else tuple(speeds)
+
+
+def _lqg(kind: str, params: Params, dt: float, obs_noise: float,
+         speeds: tuple | None) -> LQGPolicy:
+    """An LQG baseline ("lqg" or "modal_lqg") on the shared table for its (checked) sensor
+    noise and design ``speeds`` (None: the default)."""
+    return LQGPolicy(params, dt=dt, obs_noise=obs_noise,
+                     schedule=default_schedule(kind, params, float(dt), speeds, obs_noise))

@@ -38,6 +38,23 @@ def schedule_speeds(wind_range: tuple[float, float]) -> np.ndarray:
     return start + SCHEDULE_STEP * np.arange(n)
 
 
+def covering_speeds(wind_range: tuple[float, float]) -> np.ndarray | None:
+    """Design speeds of a schedule that keeps :data:`DEFAULT_SPEEDS` and covers the top of
+    ``wind_range`` (low, high) [m/s]: None (the default table) where ``high`` is at most its
+    top 16 m/s, else the default speeds continued in :data:`SCHEDULE_STEP` to one step above
+    ``high`` ((20, 25) gives 2, 3, ..., 26).
+
+    Above the top design speed the interpolated gains clamp to those designed there, for a
+    dynamic pressure (U / 16 m/s)^2 times smaller than the wind's; below the lowest they
+    fade to the braked winch instead (:func:`low_wind_fade`: a design at 1 m/s did not damp
+    the pendulum better), so the low end stays the default's. The default speeds are kept
+    exactly, so the gains inside 2-16 m/s are the default table's."""
+    hi = float(wind_range[1])
+    if hi <= DEFAULT_SPEEDS[-1]:
+        return None
+    return schedule_speeds((float(DEFAULT_SPEEDS[0]) + SCHEDULE_STEP, hi))
+
+
 def low_wind_fade(U, lowest: float) -> np.ndarray:
     """Factor on a schedule's feedback gains at wind speed U below its lowest design speed
     ``lowest``: (U / lowest)^2, 1 from ``lowest`` up, 0 at zero wind (the braked winch).

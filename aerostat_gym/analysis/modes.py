@@ -443,6 +443,8 @@ class Sweep:
     ----------
     values : swept values. variable : its name. analyses : one :class:`ModalAnalysis` per value.
     tracks : per set, list of (label, [Mode or None per value]). seconds : wall time.
+    stop_error : the :class:`TrimError` of the first value with no trim, where a sweep with
+    ``stop_without_trim`` ended there (else None).
     """
 
     values: np.ndarray
@@ -450,6 +452,7 @@ class Sweep:
     analyses: list
     tracks: dict
     seconds: float
+    stop_error: Exception | None = None
 
     def curve(self, subset: str, label: str, quantity: str = "period",
               oscillatory_only: bool = False) -> np.ndarray:
@@ -635,15 +638,18 @@ def wind_sweep(params: Params | None = None, speeds=None, eps: float = 1e-5,
     params = params or load_params()
     speeds = np.arange(0.0, 20.0 + 1e-9, 0.5) if speeds is None else np.asarray(speeds, float)
     t0 = time.perf_counter()
-    analyses, eq = [], None
+    analyses, eq, stop_error = [], None, None
     for u in speeds:
         try:
             eq = find_equilibrium(params, float(u), guess=eq)
-        except TrimError:
+        except TrimError as exc:
             if not (stop_without_trim and analyses):
                 raise
+            stop_error = exc
             break
         analyses.append(analyse(params, eq, eps))
-    return sweep_analyses(analyses, [params] * len(analyses), speeds[: len(analyses)],
-                          "wind_speed_m_s", time.perf_counter() - t0)
+    sweep = sweep_analyses(analyses, [params] * len(analyses), speeds[: len(analyses)],
+                           "wind_speed_m_s", time.perf_counter() - t0)
+    sweep.stop_error = stop_error
+    return sweep
 

@@ -30,7 +30,7 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from ..checks import is_finite_number
-from ..params import MAX_WIND_SPEED, Params, load_params, paid_out_weight
+from ..params import MAX_WIND_SPEED, Params, load_params, paid_out_weight, profile_factor
 from ..physics.core import rotation_matrix
 from ..physics.state import S_Z
 from ..sim import Model
@@ -242,9 +242,26 @@ def _continue_in_wind(model: Model, x: np.ndarray, u: float, wind_speed: float,
     x, u, rel, its, stalled = _continue(solve, x, u, wind_speed, max_step, max_step,
                                         max_step / 64, tol)
     if stalled is not None:
-        raise TrimError(f"no equilibrium found at U = {stalled:.3f} m/s (continuing from "
+        height = float(x[model.layout.at(S_Z)])  # the last equilibrium's
+        raise TrimError(f"no equilibrium found at U = {stalled:.3f} m/s"
+                        f"{at_height(model.params, stalled, height)} (continuing from "
                         f"{u:.3f} m/s): relative residual {rel:.2e} > {tol:.0e}")
     return x, rel, its
+
+
+def at_height(params: Params, wind_speed: float, height: float) -> str:
+    """Where the mean profile is not uniform, `` at wind.reference_height = 10 m (V m/s at the
+    aerostat's height of z m: wind.profile = ..., its shape parameter)`` to follow ``at U =
+    ... m/s`` in a message (the speed a trim is continued in is the one at the reference
+    height, which a steep profile multiplies many times at the aerostat); else ``""``."""
+    w = params.wind
+    if w.profile == "uniform":
+        return ""
+    shape = (f"wind.shear_exponent = {w.shear_exponent:g}" if w.profile == "power"
+             else f"wind.roughness_length = {w.roughness_length:g} m")
+    return (f" at wind.reference_height = {w.reference_height:g} m "
+            f"({wind_speed * profile_factor(params, height):.4g} m/s at the aerostat's height "
+            f"of {height:.0f} m: wind.profile = '{w.profile}', {shape})")
 
 
 #: Where the tether weighs more than this share of the net lift, a failed continuation in wind
@@ -449,16 +466,17 @@ def limit_warnings(params: Params, summary: dict) -> list[str]:
     T_w = summary["winch_tension_N"]
     T_max = float(largest_trim_tension(summary["top_tension_N"], T_w))
     U = summary["wind_speed_m_s"]
+    where = f"at U = {U:g} m/s" + at_height(params, U, summary["aerostat_position_m"][2])
     t, w = params.tether, params.winch
     if T_max >= t.strength:
-        raise TrimLimitError(f"at U = {U:g} m/s the trim tension {T_max:.0f} N exceeds "
+        raise TrimLimitError(f"{where} the trim tension {T_max:.0f} N exceeds "
                              f"tether.strength = {t.strength:.0f} N: the tether breaks")
     out = []
     if T_w > w.max_motor_force:
-        out.append(f"at U = {U:g} m/s the winch tension {T_w:.0f} N exceeds "
+        out.append(f"{where} the winch tension {T_w:.0f} N exceeds "
                    f"winch.max_motor_force = {w.max_motor_force:.0f} N: the winch holds on its "
                    "brake and cannot reel in")
     if T_max > w.safe_working_load:
-        out.append(f"at U = {U:g} m/s the trim tension {T_max:.0f} N exceeds "
+        out.append(f"{where} the trim tension {T_max:.0f} N exceeds "
                    f"winch.safe_working_load = {w.safe_working_load:.0f} N")
     return out

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 
@@ -34,6 +35,7 @@ from .common import (
     positive_int,
     seed_int,
 )
+from .stability import eigenvalue_text
 
 
 def add_train_parser(sub) -> None:
@@ -188,8 +190,15 @@ def _demo_command(args) -> int:
     return 0
 
 
+#: The modes the demo's summary always lists: [LN02] Table 2's four and the axial spring.
+DEMO_MODES = (("long", "pendulum"), ("long", "pitching"), ("long", "axial spring"),
+              ("lat", "pendulum"), ("lat", "rolling"))
+
+
 def demo_summary(params, wind: float, label: str = "baseline") -> list[str]:
-    """The demo's trim and linear-stability summary, as lines of text."""
+    """The demo's trim and linear-stability summary, as lines of text: the modes of
+    :data:`DEMO_MODES` and then every unstable mode, so that "all modes stable = False" always
+    names its culprits."""
     eq = find_equilibrium(params, wind)
     s = eq.summary
     x, _, z = s["aerostat_position_m"]
@@ -198,13 +207,22 @@ def demo_summary(params, wind: float, label: str = "baseline") -> list[str]:
              f"pitch {s['pitch_deg']:.2f} deg, winch tension {s['winch_tension_N'] / 1e3:.2f} kN"]
     ana = analyse(params, eq)
     lines.append(f"  linear stability: all modes stable = {ana.all_stable()}")
-    for subset, label_ in (("long", "pendulum"), ("long", "pitching"), ("long", "axial spring"),
-                           ("lat", "pendulum"), ("lat", "rolling")):
+    for subset, label_ in DEMO_MODES:
         m = ana.find(subset, label_)
         if m is not None:
             name = SET_NAMES[subset]
             lines.append(f"    {name:12s} {label_:13s} {m.describe()}")
-    return lines
+    return lines + unstable_mode_lines(ana)
+
+
+def unstable_mode_lines(ana) -> list[str]:
+    """One line per unstable mode of a :class:`ModalAnalysis`, listed above or not: its set,
+    label, eigenvalue and the time its amplitude takes to double, ln 2 / Re(lambda) (the
+    growth of a real root and the envelope of an oscillatory one alike)."""
+    return [f"    UNSTABLE {SET_NAMES[subset]:12s} {m.label:13s} lambda = "
+            f"{eigenvalue_text(m.eigenvalue)} 1/s, doubles in "
+            f"{math.log(2.0) / m.eigenvalue.real:.3g} s"
+            for subset in ("long", "lat") for m in getattr(ana, subset) if not m.stable]
 
 
 def add_agent_parsers(sub) -> None:

@@ -162,16 +162,37 @@ def format_summary(s: dict) -> str:
     lines.append("parameters vs instability: r (unstable somewhere; '-' when every set is "
                  "stable), Spearman rho (max Re lambda), unstable rate in the low / high fifth "
                  "of the range")
+    if not s["correlations"]:
+        lines.append(f"  none: the correlations need 2 complete sweeps, {s['complete']} ran")
+    elif s["stable_everywhere"]["fraction_of_complete"] == 0:
+        lines.append(f"  r '-': all {s['complete']} complete sweeps are unstable somewhere (r "
+                     "needs both outcomes)")
     for r in s["correlations"]:
-        corr = r["r_unstable"]
-        corr = f"{corr:+.3f}" if math.isfinite(corr) else f"{'-':>6s}"
-        lines.append(f"  {r['parameter']:26s} r {corr}  rho {r['rho_max_real']:+.3f}"
-                     f"  {_pct(r['unstable_rate_low_fifth'])} % / {_pct(r['unstable_rate_high_fifth'])} %")
-    for m in s["mode_instabilities"]:
-        u = m["speeds_m_s"]
-        lines.append(f"  unstable {m['mode']}: {m['samples_unstable']} sets, at {len(u)} speeds in "
-                     f"{min(u):g}-{max(u):g} m/s; follows {m['top_parameter']} (r {m['r']:+.2f})")
+        lines.append(f"  {r['parameter']:26s} r {_corr(r['r_unstable'], '+.3f')}  rho "
+                     f"{_corr(r['rho_max_real'], '+.3f')}  {_pct(r['unstable_rate_low_fifth'])} %"
+                     f" / {_pct(r['unstable_rate_high_fifth'])} %")
+    lines += [_mode_instability_line(m, s["samples"]) for m in s["mode_instabilities"]]
     return "\n".join(lines)
+
+
+def _corr(value: float, spec: str) -> str:
+    """A correlation, or '-' where it is undefined (an outcome or a parameter is constant)."""
+    return format(value, spec) if math.isfinite(value) else f"{'-':>6s}"
+
+
+def _mode_instability_line(m: dict, samples: int) -> str:
+    """Where a mode is unstable, counted as the probability table counts (every set, at the
+    speeds its sweep reached), and the parameter its instability follows over the complete
+    sweeps, or why none can be named. Where a sweep failed, the line says what it counts."""
+    u = m["speeds_m_s"]
+    partial = m["complete"] < samples
+    count = (f"{m['samples_unstable']} of {samples} sets (failed sweeps counted up to where "
+             "they failed)" if partial else f"{m['samples_unstable']} sets")
+    over = f" over the {m['complete']} complete sweeps" if partial else ""
+    follows = (f"follows {m['top_parameter']} (r {m['r']:+.2f}{over})"
+               if m["top_parameter"] is not None else f"no parameter named: {m['no_r']}")
+    return (f"  unstable {m['mode']}: {count}, at {len(u)} speeds in {min(u):g}-{max(u):g} m/s; "
+            f"{follows}")
 
 
 def _probability_lines(s: dict) -> list[str]:

@@ -5,7 +5,9 @@
 * ``stability --wind 0:20:0.5 [--length 300] [--elements 10] [--config FILE] [--set K=V]
   [--json] [--plot DIR]``: trim, linearize and analyse at every wind speed; print the Figure 9
   modes (period and damping ratio), stability and the coupling ratios; ``--plot`` writes the
-  Figure 9 PNG, CSV and JSON into DIR.
+  Figure 9 PNG, CSV and JSON into DIR. Past the first speed whose trim breaks the tether or
+  cannot be found the sweep stops: it reports the speeds below and says where and why it
+  stopped (a warning, a last line, ``"stop"`` in the JSON).
 * ``table2 [--config FILE] [--json]``: Table 2 for the configured aerostat, its linear model
   against its own closed forms (the paper's columns only for the paper's case).
 * ``sensitivity [--config FILE] [--wind A:B:S] [--knob KEY] [--json]``: how the estimated
@@ -33,7 +35,7 @@ from ..analysis.sensitivity import (
     select_knobs,
     sensitivity_table,
 )
-from ..analysis.trim import TrimLimitError, find_equilibrium, limit_warnings
+from ..analysis.trim import TrimError, TrimLimitError, find_equilibrium, limit_warnings
 from ..extras import require_plotting
 from ..params import MAX_WIND_SPEED
 from .common import (
@@ -124,7 +126,7 @@ def _speeds_text(speeds: list[float]) -> str:
     return f"{speeds[0]:g}-{speeds[-1]:g} m/s ({len(speeds)} speeds)"
 
 
-def _eigenvalue_text(lam: complex) -> str:
+def eigenvalue_text(lam: complex) -> str:
     """lambda [1/s] of a mode: one real number, or the pair Re +/- Im j."""
     return f"{lam.real:+.4g}" if lam.imag == 0 else f"{lam.real:+.4g} +/- {lam.imag:.4g}j"
 
@@ -137,7 +139,7 @@ def _unstable_line(entry: dict) -> str:
     subset = SET_NAMES[entry["set"]]
     return (f"  UNSTABLE {subset} {entry['label']} at U = {_speeds_text(entry['values'])}; "
             f"fastest at {entry['worst_value']:g} m/s: lambda = "
-            f"{_eigenvalue_text(worst.eigenvalue)} 1/s, {worst.describe().strip()}")
+            f"{eigenvalue_text(worst.eigenvalue)} 1/s, {worst.describe().strip()}")
 
 
 def _unstable_json(sweep) -> list[dict]:
@@ -148,35 +150,74 @@ def _unstable_json(sweep) -> list[dict]:
             for u in sweep.unstable()]
 
 
-def held_speeds(params, speeds: np.ndarray) -> np.ndarray:
-    """The sweep's speeds whose trim the tether holds, with a warning for what the winch and
-    tether cannot do at the top one and for the speeds left out. The tension grows with the
-    wind, so the sweep stops below the first speed past the tether's strength (found by
-    bisection); none held is the lowest speed's :class:`TrimLimitError`."""
-    speeds = np.sort(np.asarray(speeds, float))
-
-    def warnings_at(k):  # TrimLimitError past the tether's strength
-        return limit_warnings(params, find_equilibrium(params, float(speeds[k])).summary)
-
+def _trim_outcome(params, speed: float) -> tuple[Exception | None, list[str]]:
+    """(why ``speed`` has no usable trim or None, the winch's limit warnings there): no
+    equilibrium (:class:`TrimError`) or one whose tension breaks the tether
+    (:class:`TrimLimitError`)."""
     try:
-        messages, top, broken = warnings_at(len(speeds) - 1), len(speeds) - 1, None
-    except TrimLimitError as exc:
-        broken, held, past = exc, -1, len(speeds) - 1  # speeds[past] breaks it
+        return None, limit_warnings(params, find_equilibrium(params, speed).summary)
+    except (TrimError, TrimLimitError) as exc:
+        return exc, []
+
+
+def _stop_reason(exc: Exception, speed: float) -> str:
+    """Why the sweep ends before ``speed``: a broken tether names its speed and tension; a
+    failed trim is told where it failed."""
+    return str(exc) if isinstance(exc, TrimLimitError) else f"no trim at {speed:g} m/s: {exc}"
+
+
+def trimmed_speeds(params, speeds: np.ndarray) -> tuple[np.ndarray, dict | None]:
+    """(the sweep's speeds that trim within the tether's strength, why the sweep stops short or
+    None), with a warning for what the winch and tether cannot do at the top one and one for
+    the speeds left out. The tension grows with the wind and a trim is continued up from still
+    air, so past the first speed that breaks the tether or has no trim none is usable: that
+    speed is found by bisection. None usable re-raises the lowest speed's error."""
+    speeds = np.sort(np.asarray(speeds, float))
+    top = len(speeds) - 1
+    failure, messages = _trim_outcome(params, float(speeds[top]))
+    stop = None
+    if failure is not None:
+        held, past = -1, top  # speeds[past] has no usable trim
         while past - held > 1:
             mid = (held + past) // 2
-            try:
-                warnings_at(mid)
+            exc_mid, _ = _trim_outcome(params, float(speeds[mid]))
+            if exc_mid is None:
                 held = mid
-            except TrimLimitError as exc_mid:
-                broken, past = exc_mid, mid
+            else:
+                failure, past = exc_mid, mid
         if held < 0:
-            raise broken from None
-        messages, top = warnings_at(held), held
+            raise failure
+        top = held
+        messages = _trim_outcome(params, float(speeds[top]))[1]
+        stop = {"last_wind_speed_m_s": float(speeds[top]),
+                "failed_wind_speed_m_s": float(speeds[past]),
+                "reason": _stop_reason(failure, float(speeds[past]))}
     for message in messages:
         warn("stability", message)
-    if broken is not None:
-        warn("stability", f"the sweep stops at {speeds[top]:g} m/s: {broken}")
-    return speeds[: top + 1]
+    if stop is not None:
+        warn("stability", _stop_text(stop))
+    return speeds[: top + 1], stop
+
+
+def held_speeds(params, speeds: np.ndarray) -> np.ndarray:
+    """The speeds of :func:`trimmed_speeds` (with its warnings)."""
+    return trimmed_speeds(params, speeds)[0]
+
+
+def _stop_text(stop: dict) -> str:
+    return f"the sweep stops at {stop['last_wind_speed_m_s']:g} m/s: {stop['reason']}"
+
+
+def _sweep_stop(sweep, speeds: np.ndarray, stop: dict | None) -> dict | None:
+    """The stop of :func:`trimmed_speeds`, or (with a warning) the one of a sweep whose trims,
+    continued from speed to speed, end below the speeds that trim from still air."""
+    if len(sweep.values) == len(speeds):
+        return stop
+    failed = float(speeds[len(sweep.values)])
+    stop = {"last_wind_speed_m_s": float(sweep.values[-1]), "failed_wind_speed_m_s": failed,
+            "reason": _stop_reason(sweep.stop_error, failed)}
+    warn("stability", _stop_text(stop))
+    return stop
 
 
 def cmd_stability(args) -> int:
@@ -184,14 +225,15 @@ def cmd_stability(args) -> int:
     if args.plot:  # before the sweep: a long run never ends on a path it cannot write
         require_plotting("--plot")
         output_dir(args.plot, "--plot")
-    speeds = held_speeds(params, parse_speeds(args.wind))
-    sweep = wind_sweep(params, speeds)
+    speeds, stop = trimmed_speeds(params, parse_speeds(args.wind))
+    sweep = wind_sweep(params, speeds, stop_without_trim=True)
+    stop = _sweep_stop(sweep, speeds, stop)
     ratios = [a.decoupled.ratios for a in sweep.analyses]
     if args.plot:
         write_figure9(args.plot, params, sweep=sweep)
     if args.json:
         out = {"tether_length_m": params.tether.length, "n_elements": params.tether.n_elements,
-               "all_stable": sweep.all_stable(), "seconds": sweep.seconds,
+               "all_stable": sweep.all_stable(), "seconds": sweep.seconds, "stop": stop,
                "unstable_modes": _unstable_json(sweep),
                "coupling_ratios": ratios, "figure9": figure9_data(sweep),
                "modes": sweep.rows()}
@@ -200,6 +242,8 @@ def cmd_stability(args) -> int:
         print(f"Linear stability, L = {params.tether.length:g} m, n = {params.tether.n_elements}, "
               f"trim pitch {params.aerostat.trim_pitch_deg:g} deg")
         print(_stability_text(sweep, ratios))
+        if stop is not None:
+            print(_stop_text(stop))
     return 0
 
 

@@ -58,8 +58,14 @@ from .model import (
     validated,
 )
 from .plausible import (
+    AEROSTAT_MASS_RATIO_MIN,
+    AEROSTAT_MASS_RATIO_WARN,
     FIN_AFT_OF_TAIL,
     FIN_RADIUS_MAX,
+    GYRATION_PITCH_MAX,
+    GYRATION_PITCH_WARN,
+    GYRATION_ROLL_MAX,
+    GYRATION_ROLL_WARN,
     HULL_CDC_MAX,
     HULL_CDC_WARN,
     HULL_FINENESS_MAX,
@@ -70,17 +76,25 @@ from .plausible import (
     LEASH_DEPTH_MAX,
     PLAUSIBLE_RANGES,
     RK4_SAFETY_LIMIT,
+    ROUGHNESS_LENGTH_MAX,
+    ROUGHNESS_LENGTH_WARN,
     SEMI_IMPLICIT_REFUSE_FACTOR,
+    SHEAR_EXPONENT_MAX,
+    SHEAR_EXPONENT_WARN,
     TETHER_BREAK_STRAIN_MAX,
     TETHER_BREAK_STRAIN_WARN,
     TETHER_DENSITY_MAX,
     TETHER_DENSITY_WARN,
     TETHER_LIFT_STRAIN_MAX,
     TETHER_MODULUS_MAX,
+    TRIM_PITCH_WARN,
     ImplausibleParameterError,
     check_plausibility,
+    gyration_radii,
     hull_integral_warnings,
+    mass_ratio,
     plausibility_warnings,
+    profile_factor,
     turbulence_height_warnings,
 )
 from .schema import (
@@ -125,6 +139,10 @@ from .steps import (
 from .table import parameter_table
 
 __all__ = [
+    "AEROSTAT_MASS_RATIO_MIN", "AEROSTAT_MASS_RATIO_WARN", "GYRATION_PITCH_MAX",
+    "GYRATION_PITCH_WARN", "GYRATION_ROLL_MAX", "GYRATION_ROLL_WARN", "ROUGHNESS_LENGTH_MAX",
+    "ROUGHNESS_LENGTH_WARN", "SHEAR_EXPONENT_MAX", "SHEAR_EXPONENT_WARN", "TRIM_PITCH_WARN",
+    "gyration_radii", "mass_ratio", "profile_factor",
     "ANY", "AerostatParams", "BASELINE_NAME", "BOOL", "COEFFS", "Derived", "EFFICIENCY",
     "EnvironmentParams", "FIN_AFT_OF_TAIL", "FIN_RADIUS_MAX", "FRACTION", "FinPanel", "FinParams",
     "HULL_CDC_MAX", "HULL_CDC_WARN", "HULL_FINENESS_MAX", "HULL_FINENESS_MIN",

@@ -84,6 +84,55 @@ LEASH_DEPTH_MAX = 3.0
 #: 0.3-1.2 (super- to subcritical), a flat plate 2.0, a concave half-cylinder face 2.3, the
 #: largest of any section. Above WARN: unusual; above MAX: no section.
 HULL_CDC_WARN, HULL_CDC_MAX = 1.5, 3.0
+#: aerostat.mass / (environment.rho_air * aerostat.volume), the total mass (lifting gas and
+#: ballonet air included, as aerostat.mass means) per mass of the air the hull displaces. The
+#: lifting gas alone weighs its molar mass over the air's times rho_air V at equal pressure and
+#: temperature (a superpressure makes it heavier): hydrogen 2.016 / 28.97 = 0.070, helium
+#: 4.003 / 28.97 = 0.138; envelope, fins and payload bring aerostats to 0.4-0.8 (the baseline
+#: and the 32 m class 0.547). Below MIN the aerostat weighs less than hydrogen filling its hull
+#: (1 g on the baseline's 519 m^3, or a mass in tonnes: 0.33 is 5.5e-4); below WARN less than
+#: helium and a light envelope. The upper end, a positive net lift (ratio < 1), is refused on
+#: every load, override and replace (constraints.check_constraints).
+AEROSTAT_MASS_RATIO_MIN, AEROSTAT_MASS_RATIO_WARN = 0.05, 0.25
+#: Radii of gyration k = sqrt(I / aerostat.mass) of the body's own moments of inertia (hull,
+#: gases, fins and payload; the added masses k1, k3 are apart), roll k_x against
+#: aerostat.diameter D, pitch and yaw k_y, k_z against aerostat.length L. The lifting gas is at
+#: least 7 % of the mass (hydrogen's 0.070 rho_air V, against a mass below rho_air V) and fills
+#: the hull, so even in a double cone (the thinnest hull: prismatic 1/3) it alone gives
+#: k_x >= sqrt(0.07 * 0.075) D = 0.072 D and k_y, k_z >= sqrt(0.07 / 40) L = 0.042 L (helium,
+#: 0.138: 0.10 D and 0.059 L); an envelope shell at D / 2 raises them to the aerostats' 0.3-0.45 D
+#: and 0.2-0.3 L (baseline and 32 m class: k_x 0.40 D, k_y 0.26 L, k_z 0.26 L). Above: a
+#: radius of gyration is at most the farthest mass's distance, and mass spread over a span s
+#: has k <= s / 2 (Popoviciu's inequality): the hull gives k_x <= D / 2 and k_y, k_z <= about
+#: L / 2, fins reach up to 2 D off the axis (FIN_RADIUS_MAX) and 0.25 L aft of the tail.
+#: Refused: k_x outside 0.02-2 D, k_y or k_z outside 0.02-1 L (an inertia in g m^2, or in
+#: t m^2, is 1000 times off: k 31.6 times; on the baseline k_x 12.7 D or 0.013 D); warning:
+#: k_x outside 0.1-0.75 D (half again a thin shell's 0.5 D), k_y or k_z outside 0.06-0.5 L
+#: (0.5 L: all mass at the hull's two ends). The lower refusals stay below the ends of a
+#: +-90 % inertia randomisation (0.1 x the moments: 0.32 k) of a needle-like hull
+#: (tests/test_reliability.py: Ixx 200 kg m^2 on the baseline, k_x 0.032 D at that end).
+GYRATION_ROLL_MAX, GYRATION_ROLL_WARN = (0.02, 2.0), (0.1, 0.75)
+GYRATION_PITCH_MAX, GYRATION_PITCH_WARN = (0.02, 1.0), (0.06, 0.5)
+#: aerostat.trim_pitch_deg (negative = nose up), the zero-wind trim pitch that fixes the leash
+#: point: [LN02] quotes a manufacturer's 5-10 deg nose up and flies 4 deg (the shipped files
+#: -4, the generated aerostats -6..0). Outside WARN (more than 20 deg nose up or 10 deg nose
+#: down in still air) no aerostat is rigged: at 60 deg the baseline trims 21 deg nose down with
+#: 37 deg of blow-by at 10 m/s. The field's own check refuses |pitch| >= 89 deg.
+TRIM_PITCH_WARN = (-20.0, 10.0)
+#: wind.shear_exponent of the power profile U (z / z_ref)^alpha, fitted to atmospheric boundary
+#: layers: 0.06-0.1 over open sea and in unstable air, 1/7 over open land in neutral air,
+#: 0.25-0.4 over suburbs and cities, up to about 0.6 in very stable nights over rough land
+#: (the Hellmann-exponent tables of wind-energy texts). Above WARN only such nights, in light
+#: wind; above MAX no boundary layer (1: linear growth; 0.6 already takes 10 m/s at 10 m to
+#: 77 m/s at 300 m, 3 to 2.7e5 m/s). Checked where wind.profile = "power".
+SHEAR_EXPONENT_WARN, SHEAR_EXPONENT_MAX = 0.5, 1.0
+#: [m] wind.roughness_length z0 of the log profile U ln(z / z0) / ln(z_ref / z0): from about
+#: 1e-5 m over calm sea and 0.03-0.1 m over grass and crops to 1-2 m over city centres
+#: (Wieringa 1992, J. Wind Eng. Ind. Aerodyn. 41, the Davenport classes: "chaotic" high-rise
+#: centres >= 2 m; measured values up to about 3 m). Above WARN only high-rise centres (or
+#: 2-5 cm written as m); above MAX no terrain (9 m takes 10 m/s at 10 m to 330 m/s at 300 m).
+#: Checked where wind.profile = "log" (constraints also refuse z0 >= z_ref on every door).
+ROUGHNESS_LENGTH_WARN, ROUGHNESS_LENGTH_MAX = 2.0, 5.0
 #: wind.turbulence_reference_height more than this factor from tether.length warns at load
 TURBULENCE_HEIGHT_WARN = 1.5
 
@@ -136,6 +185,8 @@ def check_plausibility(p: Params) -> None:
     when an environment is made (:data:`PLAUSIBLE_RANGES` on every load and replace too)."""
     _plausible_tether(p)
     _plausible_hull(p)
+    _plausible_mass(p)
+    _plausible_wind(p)
     _plausible_body_points(p)
     _plausible_numerics(p)
 
@@ -203,6 +254,99 @@ def _plausible_hull(p: Params) -> None:
             f"{fineness:.3g} lies outside [{HULL_FINENESS_MIN:g}, {HULL_FINENESS_MAX:g}] (a "
             "sphere has 1, aerostats 2.2-4, the slimmest airships about 8)"
             + ("; looks like length and diameter swapped" if fineness < 1 else ""))
+
+
+def mass_ratio(p: Params) -> float:
+    """aerostat.mass / (environment.rho_air * aerostat.volume): the total mass per mass of air
+    displaced (:data:`AEROSTAT_MASS_RATIO_MIN`)."""
+    return safe_ratio(p.aerostat.mass, p.environment.rho_air * p.aerostat.volume)
+
+
+def gyration_radii(p: Params) -> list[tuple[str, float, float, str, tuple, tuple]]:
+    """(field, moment, radius of gyration sqrt(I / mass) over its reference length, the
+    reference's name, refused bounds, warning bounds) of Ixx (against the diameter), Iyy and
+    Izz (against the length)."""
+    a = p.aerostat
+    out = []
+    for name, ref, ref_name, refuse, warn in (
+            ("Ixx", a.diameter, "aerostat.diameter", GYRATION_ROLL_MAX, GYRATION_ROLL_WARN),
+            ("Iyy", a.length, "aerostat.length", GYRATION_PITCH_MAX, GYRATION_PITCH_WARN),
+            ("Izz", a.length, "aerostat.length", GYRATION_PITCH_MAX, GYRATION_PITCH_WARN)):
+        moment = getattr(a, name)
+        out.append((f"aerostat.{name}", moment, safe_ratio(math.sqrt(moment / a.mass), ref),
+                    ref_name, refuse, warn))
+    return out
+
+
+def _plausible_mass(p: Params) -> None:
+    """The mass against the air the hull displaces, and the radii of gyration against the
+    hull's diameter and length (unit slips of tonnes, g m^2, t m^2)."""
+    a = p.aerostat
+    displaced = p.environment.rho_air * a.volume
+    ratio, lo = mass_ratio(p), AEROSTAT_MASS_RATIO_MIN
+    if ratio < lo:
+        raise ImplausibleParameterError(
+            f"aerostat.mass = {a.mass:g} kg is {ratio:.3g} of the {displaced:.4g} kg of air the "
+            f"hull displaces (environment.rho_air * aerostat.volume), below {lo:g}: the mass "
+            "includes the lifting gas, which alone weighs 0.070 (hydrogen) to 0.138 (helium) "
+            "of it; aerostats weigh 0.4-0.8 of it"
+            + slip_hint(a.mass, {"tonnes written as kg": 1e3},
+                        lambda v: lo <= safe_ratio(v, displaced) < 1.0))
+    for key, moment, k, ref_name, (low, high), _ in gyration_radii(p):
+        if low <= k <= high:
+            continue
+        ref = getattr(a, ref_name.split(".")[1])
+        ok = lambda v, r=ref, lo_=low, hi=high: lo_ <= math.sqrt(v / a.mass) / r <= hi  # noqa: E731
+        raise ImplausibleParameterError(
+            f"{key} = {moment:g} kg m^2 gives a radius of gyration sqrt({key} / aerostat.mass) "
+            f"= {k * ref:.4g} m, {k:.3g} x {ref_name} = {ref:g} m, outside [{low:g}, {high:g}] "
+            f"x {ref_name} (aerostats {'0.3-0.45' if key.endswith('Ixx') else '0.2-0.3'}; "
+            "the lifting gas alone gives more than the lower bound, and no mass lies far enough "
+            "off the hull for the upper)"
+            + slip_hint(moment, {"g m^2 written as kg m^2": 1e-3, "t m^2 written as kg m^2": 1e3,
+                                 "kg cm^2 written as kg m^2": 1e-4}, ok))
+
+
+def profile_factor(p: Params, height: float) -> float:
+    """The configured mean profile's speed at ``height`` metres above the ground over its speed
+    at wind.reference_height (1 for the uniform profile)."""
+    w = p.wind
+    z = max(height, w.roughness_length * 1.01, 0.5)  # the core's lowest height (W_ZMIN)
+    if w.profile == "power":
+        exponent = w.shear_exponent * math.log(z / w.reference_height)
+        return math.exp(min(exponent, 700.0))  # inf-like, not OverflowError, past 1e304
+    if w.profile == "log":
+        return math.log(z / w.roughness_length) / math.log(w.reference_height / w.roughness_length)
+    return 1.0
+
+
+def _flight_factor(p: Params) -> str:
+    """``: it takes ... at the aerostat's height`` for the wind profile's messages."""
+    z = p.tether.anchor_position[2] + p.tether.length
+    return (f"; it takes the reference speed {profile_factor(p, z):.3g}-fold to the aerostat's "
+            f"height (about {z:g} m: tether.length above the winch)")
+
+
+def _plausible_wind(p: Params) -> None:
+    """The mean profile's shape: the power law's exponent and the log law's roughness length,
+    where that profile is configured."""
+    w = p.wind
+    if w.profile == "power" and w.shear_exponent > SHEAR_EXPONENT_MAX:
+        raise ImplausibleParameterError(
+            f"wind.shear_exponent = {w.shear_exponent:g} exceeds {SHEAR_EXPONENT_MAX:g} for "
+            "wind.profile = 'power': atmospheric boundary layers have 0.06-0.1 over the sea, "
+            "1/7 over open land, 0.25-0.4 over cities and up to about 0.6 in very stable nights"
+            + _flight_factor(p)
+            + slip_hint(w.shear_exponent, {"a percentage written as a fraction": 0.01},
+                        lambda v: 0.05 <= v <= SHEAR_EXPONENT_WARN))
+    if w.profile == "log" and w.roughness_length > ROUGHNESS_LENGTH_MAX:
+        raise ImplausibleParameterError(
+            f"wind.roughness_length = {w.roughness_length:g} m exceeds "
+            f"{ROUGHNESS_LENGTH_MAX:g} m for wind.profile = 'log': terrain has 1e-5 m (calm "
+            "sea) to 0.1 m (crops), 1-2 m over city centres, about 3 m at most"
+            + _flight_factor(p)
+            + slip_hint(w.roughness_length, {"cm written as m": 0.01},
+                        lambda v: v <= ROUGHNESS_LENGTH_MAX))
 
 
 def _plausible_body_points(p: Params) -> None:
@@ -315,6 +459,7 @@ def plausibility_warnings(p: Params) -> list[str]:
     if p.hull.Cdc > HULL_CDC_WARN:
         out.append(f"hull.Cdc = {p.hull.Cdc:g} is above a circular cylinder's 0.3-1.2 "
                    f"(warning above {HULL_CDC_WARN:g})")
+    out.extend(_mass_and_wind_warnings(p))
     out.extend(turbulence_height_warnings(p))
     full = paid_out_weight(p, p.winch.max_length)
     if d.net_lift <= full:
@@ -325,6 +470,42 @@ def plausibility_warnings(p: Params) -> list[str]:
                    "light wind the model (which has no ground for the tether) hangs it below the "
                    "winch; lower winch.max_length or widen the margin")
     out.extend(_fin_symmetry_warnings(p))
+    return out
+
+
+def _mass_and_wind_warnings(p: Params) -> list[str]:
+    """Unusual mass, radii of gyration, trim pitch and wind profile (the bands inside the
+    refusals of :func:`_plausible_mass` and :func:`_plausible_wind`)."""
+    a, w = p.aerostat, p.wind
+    out = []
+    ratio = mass_ratio(p)
+    if ratio < AEROSTAT_MASS_RATIO_WARN:
+        out.append(f"aerostat.mass = {a.mass:g} kg is {ratio:.3g} of the air the hull displaces "
+                   "(environment.rho_air * aerostat.volume): helium alone weighs 0.138 of it, "
+                   "aerostats 0.4-0.8 (it is the total mass, lifting gas included; warning "
+                   f"below {AEROSTAT_MASS_RATIO_WARN:g})")
+    for key, moment, k, ref_name, _, (low, high) in gyration_radii(p):
+        if not low <= k <= high:
+            out.append(f"{key} = {moment:g} kg m^2 gives a radius of gyration of {k:.3g} x "
+                       f"{ref_name} (sqrt({key} / aerostat.mass); aerostats "
+                       f"{'0.3-0.45' if key.endswith('Ixx') else '0.2-0.3'}; warning outside "
+                       f"[{low:g}, {high:g}])")
+    lo, hi = TRIM_PITCH_WARN
+    if not lo <= a.trim_pitch_deg <= hi:
+        out.append(f"aerostat.trim_pitch_deg = {a.trim_pitch_deg:g} deg (negative = nose up) is "
+                   "no aerostat's zero-wind trim: [LN02] quotes 5-10 deg nose up, the shipped "
+                   f"files use -4 (warning outside [{lo:g}, {hi:g}] deg); it places the leash "
+                   "point, and with it the attitude and blow-by in every wind")
+    if w.profile == "power" and w.shear_exponent > SHEAR_EXPONENT_WARN:
+        out.append(f"wind.shear_exponent = {w.shear_exponent:g} is steeper than any boundary "
+                   "layer but a very stable night's (open land 1/7, cities 0.25-0.4; warning "
+                   f"above {SHEAR_EXPONENT_WARN:g})" + _flight_factor(p))
+    if w.profile == "log" and w.roughness_length > ROUGHNESS_LENGTH_WARN:
+        out.append(f"wind.roughness_length = {w.roughness_length:g} m is rougher than any terrain "
+                   "but a high-rise city centre (grass 0.03, suburbs 0.5, city centres 1-2 m; "
+                   f"warning above {ROUGHNESS_LENGTH_WARN:g} m)" + _flight_factor(p)
+                   + slip_hint(w.roughness_length, {"cm written as m": 0.01},
+                               lambda v: v <= ROUGHNESS_LENGTH_WARN))
     return out
 
 

@@ -106,23 +106,40 @@ def correlations(study: Study) -> list[dict]:
 
 
 def mode_instability_drivers(study: Study) -> list[dict]:
-    """For each followed mode that is unstable somewhere in some sample: how many samples, the
-    speeds, and the parameter with the largest |point-biserial r| with that instability."""
+    """For each followed mode that is unstable somewhere in some sample: how many samples
+    (``samples_unstable``, over every sample and the speeds its sweep reached, as the
+    stability table counts), the speeds, and the parameter with the largest |point-biserial r|
+    with that instability over the ``complete`` samples (``top_parameter`` and ``r``, None and
+    nan where r is undefined, with the reason in ``no_r``)."""
     ok = complete_mask(study)
-    stable, values = study.stack("stable")[ok], study.stack("values")[ok]
+    stable, values = study.stack("stable"), study.stack("values")[ok]
     out = []
     for j, (subset, label) in enumerate(MODES):
         hit = np.any(stable[:, :, j] == 0.0, axis=1)
         if not hit.any():
             continue
-        r = [point_biserial(values[:, i], hit) for i in range(len(study.keys))]
+        r = [point_biserial(values[:, i], hit[ok]) for i in range(len(study.keys))]
         best = int(np.nanargmax(np.abs(r))) if np.any(np.isfinite(r)) else None
         speeds = study.speeds[np.any(stable[:, :, j] == 0.0, axis=0)]
         out.append({"mode": f"{subset} {label}", "samples_unstable": int(hit.sum()),
-                    "speeds_m_s": [float(u) for u in speeds],
+                    "speeds_m_s": [float(u) for u in speeds], "complete": int(ok.sum()),
+                    "complete_unstable": int(hit[ok].sum()),
                     "top_parameter": study.keys[best] if best is not None else None,
-                    "r": r[best] if best is not None else math.nan})
+                    "r": r[best] if best is not None else math.nan,
+                    "no_r": None if best is not None else _why_no_r(int(ok.sum()),
+                                                                     int(hit[ok].sum()))})
     return out
+
+
+def _why_no_r(complete: int, unstable: int) -> str:
+    """Why no parameter's point-biserial r with an instability is defined: it needs two
+    complete sweeps, the instability in some and not in others, and a parameter that varies."""
+    if complete < 2:
+        return f"r needs 2 complete sweeps, {complete} ran"
+    if unstable in (0, complete):
+        return (f"{unstable} of the {complete} complete sweeps are unstable in it (r needs both "
+                "outcomes)")
+    return "no drawn parameter varies over the complete sweeps"
 
 
 def summarize(study: Study, nominal=None) -> dict:
