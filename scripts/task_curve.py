@@ -21,7 +21,7 @@ from aerostat_gym.agents.task_curve import (
     plot_curves,
     task_curve,
 )
-from aerostat_gym.cli.common import run_script, script_description
+from aerostat_gym.cli.common import first_seeds, run_script, script_description
 
 
 def main(argv=None) -> dict:
@@ -37,9 +37,7 @@ def main(argv=None) -> dict:
     if len(names) != len(args.runs) or len(set(names)) != len(names):
         raise SystemExit(f"--names needs one distinct label per run: {len(args.runs)} runs, "
                          f"names {names}")
-    if not 2 <= args.seeds <= len(TASK_CURVE_SEEDS):
-        raise SystemExit(f"--seeds must lie in [2, {len(TASK_CURVE_SEEDS)}], got {args.seeds}")
-    seeds = TASK_CURVE_SEEDS[:args.seeds]
+    seeds = first_seeds(args.seeds, TASK_CURVE_SEEDS)
     curves = {n: task_curve(r, seeds) for n, r in zip(names, args.runs, strict=True)}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -26,7 +26,7 @@ from pathlib import Path
 from aerostat_gym.agents.report import given_labels, policy_labels
 from aerostat_gym.agents.returns import task_returns
 from aerostat_gym.agents.selection import GATE_SEEDS, task_gate
-from aerostat_gym.cli.common import run_script, script_description
+from aerostat_gym.cli.common import first_seeds, run_script, script_description
 from aerostat_gym.registration import TASKS
 from aerostat_gym.resources import shipped_path
 
@@ -57,12 +57,10 @@ def main(argv=None) -> dict:
                   else given_labels(args.label, args.policy))
     except ValueError as err:
         raise SystemExit(str(err)) from None
-    if not 2 <= args.seeds <= len(GATE_SEEDS):
-        raise SystemExit(f"--seeds must lie in [2, {len(GATE_SEEDS)}], got {args.seeds}")
+    seeds = first_seeds(args.seeds, GATE_SEEDS)
     names = [*args.baselines, *labels]
     if len(set(names)) != len(names):
         raise SystemExit(f"a label is given twice: {names}")
-    seeds = GATE_SEEDS[:args.seeds]
     task = args.task or shipped_task()
     runs = [*((b, b) for b in args.baselines), *zip(labels, args.policy, strict=True)]
     returns = {label: task_returns(policy, task, seeds).tolist() for label, policy in runs}

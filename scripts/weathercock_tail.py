@@ -29,7 +29,7 @@ from aerostat_gym.agents.weathercock import (
     drawn_yaw_curves,
     tail_summary,
 )
-from aerostat_gym.cli.common import run_script, script_description
+from aerostat_gym.cli.common import first_seeds, run_script, script_description
 
 TASK_IDS = ("TetheredAerostatRealistic-v0", "TetheredAerostatRealisticWeathervaning-v0")
 
@@ -79,10 +79,8 @@ def main(argv=None) -> dict:
     ap.add_argument("--json", default=None, help="write every return here")
     ap.add_argument("--markdown", default=None, help="write the table here")
     args = ap.parse_args(argv)
-    if not 2 <= args.seeds <= len(WEATHERCOCK_SEEDS):
-        raise SystemExit(f"--seeds must lie in [2, {len(WEATHERCOCK_SEEDS)}], got {args.seeds}")
     result = study(args.policy or ["passive", "modal_lqg_shaped", "shipped"],
-                   WEATHERCOCK_SEEDS[:args.seeds])
+                   first_seeds(args.seeds, WEATHERCOCK_SEEDS))
     table = markdown(result)
     print(table)
     for path, text in ((args.json, dumps(result)), (args.markdown, table)):

@@ -58,7 +58,7 @@ from aerostat_gym.analysis.trim import TrimError, find_equilibrium
 from aerostat_gym.bench.soak import VARIANTS, soak_configuration
 from aerostat_gym.cli import main
 from aerostat_gym.cli.agents import demo_summary
-from aerostat_gym.cli.stability import held_speeds
+from aerostat_gym.cli.stability import trimmed_speeds
 from aerostat_gym.envs.batch import held_wind_top
 from aerostat_gym.envs.config import PERTURBATIONS, TaskConfig, TaskError
 from aerostat_gym.envs.episodes import TrimTable
@@ -312,7 +312,7 @@ def test_the_tether_holds_a_trim_by_its_largest_tension():
     quiet = {"params": p, "turbulence": "none", "perturbation": "none"}
     with pytest.raises(TaskError, match=r"the trim at 15\.0 m/s loads the tether with 3858 N"):
         gym.make(ENV_ID, wind_speed=15.0, **quiet)
-    swept = held_speeds(p, np.round(np.arange(3.0, 15.05, 0.1), 1))
+    swept = trimmed_speeds(p, np.round(np.arange(3.0, 15.05, 0.1), 1))[0]
     assert held_wind_top(p, 3.0, 15.0) == swept[-1] == 14.8
     with pytest.warns(UserWarning, match="winch.max_motor_force"):
         env = gym.make(ENV_ID, wind_speed=14.8, **quiet)

@@ -3,8 +3,8 @@
 ``TetheredAerostatRealistic-v0`` draws the fin lift slope and the hull efficiency
 independently; where the draw cancels the baseline's modest yaw margin the aerostat does not
 turn back into the wind and the light turbulence sails it 80-200 m across it.
-``TetheredAerostatRealisticWeathervaning-v0`` redraws those aerostats (``weathercock=True``). This module measures both on the same seeds:
-``scripts/weathercock_tail.py`` prints the table.
+``TetheredAerostatRealisticWeathervaning-v0`` redraws those aerostats (``weathercock=True``).
+This module measures both on the same seeds; ``scripts/weathercock_tail.py`` prints the table.
 """
 
 from __future__ import annotations
@@ -21,8 +21,6 @@ from .protocol_stats import bootstrap_mean_ci
 WEATHERCOCK_SEEDS = tuple(range(6000, 6200))
 #: the episodes whose share of the summed return the summary gives (the heavy tail)
 TAIL_EPISODES = 10
-
-
 #: [deg] the large yaw offsets at which a weathervaning aerostat may still push off: the
 #: baseline's margin there is thin (its 45 deg fin stall is the lowest whole degree at which it
 #: restores to 90 deg, README "Large-angle fins"), so near-nominal draws can lose it

@@ -164,6 +164,14 @@ def params_from_args(args, **extra):
 # --- the scripts in scripts/ ---------------------------------------------------------------------
 
 
+def first_seeds(count: int, seeds) -> tuple:
+    """The first ``count`` of a study's fixed seed set (``--seeds N``, a smoke run), refused
+    outside [2, len(seeds)]: a bootstrap interval needs two episodes."""
+    if not 2 <= count <= len(seeds):
+        raise SystemExit(f"--seeds must lie in [2, {len(seeds)}], got {count}")
+    return tuple(seeds[:count])
+
+
 def script_description(doc: str) -> str:
     """A script's ``--help`` description: the first paragraph of its docstring, joined (its
     first line alone stops mid-sentence)."""

@@ -199,11 +199,6 @@ def trimmed_speeds(params, speeds: np.ndarray) -> tuple[np.ndarray, dict | None]
     return speeds[: top + 1], stop
 
 
-def held_speeds(params, speeds: np.ndarray) -> np.ndarray:
-    """The speeds of :func:`trimmed_speeds` (with its warnings)."""
-    return trimmed_speeds(params, speeds)[0]
-
-
 def _stop_text(stop: dict) -> str:
     return f"the sweep stops at {stop['last_wind_speed_m_s']:g} m/s: {stop['reason']}"
 
