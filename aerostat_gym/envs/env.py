@@ -335,6 +335,12 @@ class TetheredAerostatEnv(gym.Env):
       turbulent env whose ``tether_length`` (or ``tether.length`` override) leaves the
       turbulence reference height a factor 1.5 off warns (``ParameterWarning``), as loading
       such a file does, at the caller's line (past gymnasium's frames under ``gym.make``).
+    - v0 (aerostat-gym 0.7.22; dynamics, observation, reward and the seeded episodes of every
+      task registered before unchanged): the argument ``weathercock`` (default False) and the
+      task ``TetheredAerostatRealisticWeathervaning-v0``, which sets it; at make, values no
+      aerostat has are refused (a mass below 0.05 of the displaced air, radii of gyration
+      outside 0.02-2 D or 0.02-1 L, a power-law shear exponent above 1, a log roughness
+      length above 5 m).
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": 5}
